@@ -1,0 +1,87 @@
+#pragma once
+// The network energy E(q, F) = sum of segment stretching + hinge bending terms (seed eqs. 4.14, 4.15),
+// assembled into a global gradient and a sparse Hessian over the free coordinates q, together with the
+// derivatives with respect to a strain parameter t along F(t) = F + t dF (DESIGN.md §2).
+//
+// Node positions: a free node's coordinates come from q; a fixed node (clamp) sits at F x_ref.
+// The Hessian's upper-triangular pattern is built once per model; evaluate() refills the values.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "fibernet/energy/objective.hpp"
+#include "fibernet/energy/stretch.hpp"
+#include "fibernet/model/model.hpp"
+
+namespace fibernet {
+
+struct EnergyParams {
+    StretchLaw stretch;
+};
+
+// What evaluate() computes; combine with |.
+enum Want : unsigned {
+    kValue = 0,
+    kGradient = 1,
+    kHessian = 2,
+    kStrain = 4,       // dE/dt, d2E/dq dt, d2E/dt2 along dF
+    kProjectPSD = 8,   // project each element's Hessian to PSD (Hessian only; strain derivatives stay exact)
+};
+
+struct EnergyEval {
+    double energy = 0, stretch = 0, bend = 0;
+    Eigen::VectorXd gradient;        // over free coordinates
+    double dE_dt = 0;                // strain derivatives along dF
+    Eigen::VectorXd d2E_dqdt;
+    double d2E_dt2 = 0;
+};
+
+class NetworkEnergy {
+public:
+    explicit NetworkEnergy(const Model& model, EnergyParams params = {});
+
+    const Model& model() const { return model_; }
+    int num_dofs() const { return ndof_; }
+    // Free coordinates of a node-position vector (2 per node), and back (fixed nodes at F x_ref).
+    Eigen::VectorXd dofs(const Eigen::VectorXd& x) const;
+    Eigen::VectorXd positions(const Eigen::VectorXd& q, const Eigen::Matrix2d& F) const;
+    // Index of coordinate c of node i in q, or -1 if fixed.
+    int dof(int node, int c) const { return dof_[2 * node + c]; }
+    // The state q at deformation F_old mapped affinely to F_new (a start guess for a changed strain).
+    Eigen::VectorXd affine_map(const Eigen::VectorXd& q, const Eigen::Matrix2d& F_old, const Eigen::Matrix2d& F_new) const;
+
+    // Evaluates what `want` asks at (q, F); dF is the strain direction (used with kStrain). H, if kHessian,
+    // must carry hessian_pattern()'s pattern.
+    void evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F, const Eigen::Matrix2d& dF, unsigned want,
+                  EnergyEval& out, Eigen::SparseMatrix<double>* H = nullptr) const;
+
+    const Eigen::SparseMatrix<double>& hessian_pattern() const { return pattern_; }
+
+private:
+    const Model& model_;
+    EnergyParams params_;
+    int ndof_ = 0;
+    std::vector<int> dof_;                 // 2 per node: index into q or -1
+    Eigen::SparseMatrix<double> pattern_;  // upper triangle
+    std::vector<int> seg_slots_;           // 10 per segment: value index of local upper entry (a<=b) or -1
+    std::vector<int> hinge_slots_;         // 21 per hinge
+};
+
+// The energy at a fixed deformation F, as a solver sees it.
+class StrainedEnergy : public Objective {
+public:
+    StrainedEnergy(const NetworkEnergy& e, const Eigen::Matrix2d& F) : e_(e), F_(F) {}
+    int size() const override { return e_.num_dofs(); }
+    double value(const Eigen::VectorXd& q) override;
+    double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override;
+    double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool project_psd) override;
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return e_.hessian_pattern(); }
+    const Eigen::Matrix2d& F() const { return F_; }
+
+private:
+    const NetworkEnergy& e_;
+    Eigen::Matrix2d F_;
+    EnergyEval eval_;
+};
+
+}  // namespace fibernet

@@ -1,0 +1,41 @@
+#pragma once
+// A scene (docs/formats.md, "scene"; files in problems/) says what is asked: which network, how to discretize it,
+// what load, which solver. TOML; every key is optional and has the default shown in docs/formats.md.
+// Command-line flags override a scene's values.
+#include <string>
+#include <vector>
+
+#include "fibernet/box/box.hpp"
+#include "fibernet/model/discretize.hpp"
+#include "fibernet/model/prune.hpp"
+#include "fibernet/network/mikado.hpp"
+
+namespace fibernet {
+
+struct SolverSettings {
+    std::string name = "newton";
+    double tol = 1e-10;        // max |gradient| in seed units
+    int max_iter = 500;
+};
+
+struct Scene {
+    std::string source = "defaults";  // where the values came from (file name), for messages
+    MikadoParams mikado;               // used unless network_file is set
+    std::string network_file;          // a saved network (fibernet generate) instead of a generated one
+    DiscretizationParams discretization;
+    PruneOptions prune;
+    StrainKind strain = StrainKind::Shear;
+    double gamma = 0;                  // strain parameter t of F(t)
+    SolverSettings solver;
+
+    void check() const;  // throws InputError naming the bad value and the scene's source
+};
+
+// Parses a TOML scene; unknown tables/keys and wrong types are InputErrors naming file and key.
+Scene load_scene(const std::string& path);
+Scene parse_scene(const std::string& toml_text, const std::string& source);
+
+// The network the scene describes (generated or loaded), pruned as asked.
+Network scene_network(const Scene& s);
+
+}  // namespace fibernet

@@ -1,0 +1,36 @@
+#pragma once
+// The result every solver returns (Newton, L-BFGS, NLopt, Ipopt, FIRE, CG): one status type, never a hidden failure.
+#include <Eigen/Core>
+#include <string>
+
+namespace fibernet {
+
+enum class SolveStatus {
+    Converged,          // max|g| <= tol
+    IterationLimit,     // budget spent before tol
+    LineSearchFailed,   // no acceptable step along a descent direction
+    NonFinite,          // NaN/inf energy or gradient met
+    Stalled,            // no progress possible (e.g. round-off limited, NLopt ROUNDOFF_LIMITED)
+    Failed,             // any other failure the backend reported (message says which)
+};
+std::string to_string(SolveStatus s);
+
+struct SolveTimings {
+    double assembly = 0, factorization = 0, solve = 0, line_search = 0, total = 0;  // seconds
+};
+
+struct SolveResult {
+    SolveStatus status = SolveStatus::Failed;
+    std::string solver;                 // name, e.g. "newton"
+    std::string message;                // detail from the backend or the ladder
+    int iterations = 0;
+    int factorizations = 0;
+    int evaluations = 0;                // energy/gradient evaluations
+    double energy = 0;
+    double grad_max = 0;                // max |g| at the returned state
+    SolveTimings timings;
+
+    bool converged() const { return status == SolveStatus::Converged; }
+};
+
+}  // namespace fibernet

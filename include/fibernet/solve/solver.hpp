@@ -1,0 +1,31 @@
+#pragma once
+// A minimizer of an Objective: it sees only value, gradient and Hessian. Every solver in solve/ implements this and
+// is created by name (make_solver) so that `--solver` can pick any of them.
+#include <memory>
+#include <string>
+
+#include "fibernet/energy/objective.hpp"
+#include "fibernet/solve/result.hpp"
+
+namespace fibernet {
+
+struct SolverOptions {
+    double tol = 1e-10;      // stop at max|g| <= tol
+    int max_iter = 500;      // iteration budget (solver-specific meaning: Newton steps, L-BFGS iterations, ...)
+    double max_seconds = 0;  // wall-time budget, 0 = none
+    bool verbose = false;    // progress to stderr
+};
+
+class Solver {
+public:
+    virtual ~Solver() = default;
+    virtual std::string name() const = 0;
+    // Minimizes f starting from q, overwriting q with the final state. The result's status says whether q is
+    // an equilibrium; callers must not report an unconverged q as one.
+    virtual SolveResult minimize(Objective& f, Eigen::VectorXd& q) = 0;
+};
+
+// Throws InputError naming the solver if unknown.
+std::unique_ptr<Solver> make_solver(const std::string& name, const SolverOptions& opt);
+
+}  // namespace fibernet

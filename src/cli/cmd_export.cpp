@@ -1,0 +1,29 @@
+// fibernet export: discretize a network and write the model (docs/formats.md, "model").
+#include <iostream>
+#include <sstream>
+
+#include "common.hpp"
+#include "fibernet/model/model_io.hpp"
+#include "fibernet/network/network_io.hpp"
+
+namespace fibernet::cli {
+
+void register_export(CLI::App& app) {
+    auto* cmd = app.add_subcommand("export", "write the discretized model (nodes, segments, hinges, supernodes)");
+    auto flags = std::make_shared<SceneFlags>();
+    auto out = std::make_shared<std::string>();
+    flags->add(cmd, false);
+    cmd->add_option("-o,--output", *out, "model file to write (default: standard output)");
+    cmd->callback([flags, out] {
+        Scene s = flags->resolve();
+        Network net = scene_network(s);
+        Model m = discretize(net, s.discretization);
+        std::ostringstream os;
+        write_model(os, m);
+        if (out->empty()) std::cout << os.str();
+        else write_file_atomic(*out, os.str());
+        std::cerr << to_json(summarize(m)).dump() << "\n";
+    });
+}
+
+}  // namespace fibernet::cli

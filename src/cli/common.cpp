@@ -1,0 +1,109 @@
+#include "common.hpp"
+
+#include <chrono>
+#include <iostream>
+
+#include "fibernet/network/network_io.hpp"
+#include "fibernet/util/error.hpp"
+
+namespace fibernet::cli {
+
+void SceneFlags::add(CLI::App* app, bool with_load) {
+    opts.push_back(app->add_option("scene", scene_file, "scene file (TOML, see docs/formats.md); flags override it")
+                       ->check(CLI::ExistingFile));
+    opts.push_back(app->add_option("--network", network_file, "read this network file instead of generating one")
+                       ->check(CLI::ExistingFile));
+    opts.push_back(app->add_option("--L", L, "box side in fiber lengths (default 10)"));
+    opts.push_back(app->add_option("--q", q, "density N lf^2 / A (default 8)"));
+    opts.push_back(app->add_option("--pl", pl, "crosslink probability in [0, 1] (default 1)"));
+    opts.push_back(app->add_option("--seed", seed, "random seed (default 1)"));
+    opts.push_back(app->add_flag("--open", open, "open box instead of periodic"));
+    opts.push_back(app->add_option("--scheme", scheme, "discretization: seed | even (default seed)"));
+    opts.push_back(app->add_option("--nseg", n_seg, "seed scheme: segments per fiber (default 10)"));
+    opts.push_back(app->add_option("--h", h, "even scheme: segment length in seed units (default 1)"));
+    opts.push_back(app->add_option("--a", a, "fiber aspect ratio a = ls / r (default 10)"));
+    opts.push_back(app->add_option("--prune", prune, "drop load-free parts: dangling, nonspanning"));
+    if (with_load) {
+        opts.push_back(app->add_option("--gamma", gamma, "strain parameter (default 0)"));
+        opts.push_back(app->add_option("--strain", strain, "strain path: shear | uniaxial | uniaxial-y | isotropic"));
+        opts.push_back(app->add_option("--solver", solver, "solver (default newton)"));
+        opts.push_back(app->add_option("--tol", tol, "max |gradient| to stop at (default 1e-10)"));
+        opts.push_back(app->add_option("--max-iter", max_iter, "iteration limit (default 500)"));
+    }
+}
+
+bool SceneFlags::given(const std::string& name) const {
+    for (auto* o : opts)
+        if (o->check_name(name)) return o->count() > 0;
+    return false;
+}
+
+Scene SceneFlags::resolve() const {
+    Scene s = scene_file.empty() ? Scene{} : load_scene(scene_file);
+    const std::string who = "command line";
+    bool flags = false;
+    auto set = [&](const char* name, auto& target, const auto& value) {
+        if (given(name)) target = value, flags = true;
+    };
+    set("--network", s.network_file, network_file);
+    set("--L", s.mikado.L, L);
+    set("--q", s.mikado.q, q);
+    set("--pl", s.mikado.pl, pl);
+    set("--seed", s.mikado.seed, seed);
+    if (given("--open")) s.mikado.periodic = false, flags = true;
+    if (given("--scheme")) s.discretization.scheme = parse_scheme(scheme), flags = true;
+    set("--nseg", s.discretization.n_seg, n_seg);
+    set("--h", s.discretization.h, h);
+    set("--a", s.discretization.aspect_ratio, a);
+    if (given("--prune")) {
+        flags = true;
+        for (const auto& p : prune) {
+            if (p == "dangling") s.prune.dangling = true;
+            else if (p == "nonspanning") s.prune.nonspanning = true;
+            else throw InputError("command line: --prune " + p + " is unknown (expected dangling or nonspanning)");
+        }
+    }
+    set("--gamma", s.gamma, gamma);
+    if (given("--strain")) s.strain = parse_strain_kind(strain), flags = true;
+    set("--solver", s.solver.name, solver);
+    set("--tol", s.solver.tol, tol);
+    set("--max-iter", s.solver.max_iter, max_iter);
+    if (flags) s.source = scene_file.empty() ? who : scene_file + " with command-line overrides";
+    s.check();
+    return s;
+}
+
+nlohmann::json to_json(const NetworkStats& s) {
+    return {{"fibers", s.fibers},
+            {"crossings", s.crossings},
+            {"crosslinks", s.crosslinks},
+            {"crossings_per_fiber", s.crossings_per_fiber},
+            {"crosslinks_per_fiber", s.crosslinks_per_fiber},
+            {"components", s.components},
+            {"largest_component", s.largest_component}};
+}
+
+nlohmann::json to_json(const ModelSummary& s) {
+    return {{"nodes", s.nodes},           {"dofs", s.dofs},
+            {"segments", s.segments},     {"hinges", s.hinges},
+            {"supernodes", s.supernodes}, {"fibers", s.fibers},
+            {"shortest_segment", s.shortest_segment}, {"longest_segment", s.longest_segment},
+            {"mean_segment", s.mean_segment}};
+}
+
+void emit_json(const nlohmann::json& j, const std::string& path) {
+    const std::string text = j.dump(2) + "\n";
+    if (path.empty()) std::cout << text << std::flush;
+    else write_file_atomic(path, text);
+}
+
+int& exit_code() {
+    static int code = 0;
+    return code;
+}
+
+double seconds_since(const std::chrono::steady_clock::time_point& t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace fibernet::cli

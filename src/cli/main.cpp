@@ -1,0 +1,37 @@
+// fibernet: command-line entry. Each subcommand lives in its own cmd_<name>.cpp and registers itself here.
+// Exit codes: 0 success, 1 a computation that did not succeed (e.g. a solver that did not converge),
+// 2 bad input (flags, values, files), 3 an internal error.
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "common.hpp"
+#include "fibernet/util/error.hpp"
+
+int main(int argc, char** argv) {
+    using namespace fibernet;
+    CLI::App app{"fibernet: mechanics of random fiber networks by implicit energy minimization"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "fibernet 0.1.0");
+    cli::register_generate(app);
+    cli::register_export(app);
+    cli::register_info(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::cerr << "fibernet: error: " << e.what() << "\n";
+        return 2;
+    } catch (const InputError& e) {
+        std::cerr << "fibernet: error: " << e.what() << "\n";
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "fibernet: internal error: " << e.what() << "\n";
+        return 3;
+    }
+    return cli::exit_code();
+}

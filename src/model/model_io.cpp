@@ -1,0 +1,173 @@
+#include "fibernet/model/model_io.hpp"
+
+#include <cmath>
+#include <istream>
+#include <ostream>
+#include <sstream>
+
+#include "fibernet/util/error.hpp"
+
+namespace fibernet {
+
+void write_model(std::ostream& os, const Model& m, const Eigen::VectorXd& xin, const Eigen::Matrix2d& F) {
+    const Eigen::VectorXd& x = xin.size() ? xin : m.x;
+    os.precision(17);
+    os << "fibernet-model 1\n";
+    os << "box " << m.box.L << ' ' << (m.box.periodic ? "periodic" : "open") << '\n';
+    os << "deformation " << F(0, 0) << ' ' << F(0, 1) << ' ' << F(1, 0) << ' ' << F(1, 1) << '\n';
+    os << "aspect_ratio " << m.aspect_ratio << '\n';
+    os << "fiber_length " << m.fiber_length << '\n';
+    os << "softcore_eps_star -0.95\n";
+    os << "nodes " << m.num_nodes() << '\n';
+    for (int i = 0; i < m.num_nodes(); ++i)
+        os << x[2 * i] << ' ' << x[2 * i + 1] << ' ' << (m.fixed.empty() ? 0 : int(m.fixed[i])) << ' '
+           << m.x[2 * i] << ' ' << m.x[2 * i + 1] << '\n';
+    const double k = 4 * m.aspect_ratio * m.aspect_ratio;
+    os << "segments " << m.segments.size() << '\n';
+    for (const auto& s : m.segments)
+        os << s.i << ' ' << s.j << ' ' << s.shift.x() << ' ' << s.shift.y() << ' ' << s.l0 << ' ' << s.fiber << ' '
+           << k / s.l0 << '\n';
+    os << "hinges " << m.hinges.size() << '\n';
+    for (const auto& h : m.hinges)
+        os << h.i << ' ' << h.j << ' ' << h.k << ' ' << h.shift1.x() << ' ' << h.shift1.y() << ' ' << h.shift2.x()
+           << ' ' << h.shift2.y() << ' ' << h.lt0 << ' ' << h.fiber << ' ' << 2 / h.lt0 << '\n';
+    os << "supernodes " << m.supernodes.size() << '\n';
+    for (const auto& s : m.supernodes) {
+        os << s.node << ' ' << s.crossings.size();
+        for (int c : s.crossings) os << ' ' << c;
+        os << '\n';
+    }
+}
+
+namespace {
+struct Reader {
+    std::istream& is;
+    std::string source;
+    int line = 0;
+    std::string text;
+    [[noreturn]] void fail(const std::string& msg) const {
+        throw InputError(source + ":" + std::to_string(line) + ": " + msg);
+    }
+    std::istringstream next(const std::string& what) {
+        while (std::getline(is, text)) {
+            ++line;
+            auto p = text.find_first_not_of(" \t\r");
+            if (p == std::string::npos || text[p] == '#') continue;
+            return std::istringstream(text);
+        }
+        fail("unexpected end of file, expected " + what);
+    }
+    double num(std::istringstream& ss, const char* name) {
+        std::string t;
+        if (!(ss >> t)) fail(std::string("missing ") + name);
+        char* end;
+        double v = std::strtod(t.c_str(), &end);
+        if (*end || end == t.c_str() || !std::isfinite(v)) fail(std::string(name) + " = '" + t + "' is not a finite number");
+        return v;
+    }
+    long integer(std::istringstream& ss, const char* name, long lo, long hi) {
+        std::string t;
+        if (!(ss >> t)) fail(std::string("missing ") + name);
+        char* end;
+        long v = std::strtol(t.c_str(), &end, 10);
+        if (*end || end == t.c_str()) fail(std::string(name) + " = '" + t + "' is not an integer");
+        if (v < lo || v > hi) fail(std::string(name) + " = " + t + " is out of range");
+        return v;
+    }
+    long section(const char* kw) {
+        auto ss = next(kw);
+        std::string k;
+        ss >> k;
+        if (k != kw) fail(std::string("expected '") + kw + "', found '" + text + "'");
+        return integer(ss, kw, 0, 2000000000);
+    }
+    double keyed(const char* kw) {
+        auto ss = next(kw);
+        std::string k;
+        ss >> k;
+        if (k != kw) fail(std::string("expected '") + kw + "', found '" + text + "'");
+        return num(ss, kw);
+    }
+};
+}  // namespace
+
+Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* xout, Eigen::Matrix2d* Fout) {
+    Reader r{is, source};
+    Model m;
+    {
+        auto ss = r.next("header");
+        std::string h;
+        ss >> h;
+        if (h != "fibernet-model") r.fail("not a fibernet model file (header '" + r.text + "')");
+        r.integer(ss, "format version", 1, 1);
+    }
+    {
+        auto ss = r.next("box");
+        std::string k, kind;
+        ss >> k;
+        if (k != "box") r.fail("expected 'box L periodic|open'");
+        m.box.L = r.num(ss, "box L");
+        ss >> kind;
+        if (kind != "periodic" && kind != "open") r.fail("box kind '" + kind + "' must be periodic or open");
+        m.box.periodic = kind == "periodic";
+    }
+    Eigen::Matrix2d F;
+    {
+        auto ss = r.next("deformation");
+        std::string k;
+        ss >> k;
+        if (k != "deformation") r.fail("expected 'deformation F00 F01 F10 F11'");
+        F(0, 0) = r.num(ss, "F00"), F(0, 1) = r.num(ss, "F01"), F(1, 0) = r.num(ss, "F10"), F(1, 1) = r.num(ss, "F11");
+    }
+    m.aspect_ratio = r.keyed("aspect_ratio");
+    m.fiber_length = r.keyed("fiber_length");
+    r.keyed("softcore_eps_star");
+    const long n = r.section("nodes");
+    Eigen::VectorXd x(2 * n);
+    m.x.resize(2 * n);
+    m.fixed.assign(n, 0);
+    for (long i = 0; i < n; ++i) {
+        auto ss = r.next("node");
+        x[2 * i] = r.num(ss, "node x"), x[2 * i + 1] = r.num(ss, "node y");
+        m.fixed[i] = static_cast<char>(r.integer(ss, "node fixed flag", 0, 1));
+        m.x[2 * i] = r.num(ss, "node x_ref"), m.x[2 * i + 1] = r.num(ss, "node y_ref");
+    }
+    const long ns = r.section("segments");
+    m.segments.resize(ns);
+    for (auto& s : m.segments) {
+        auto ss = r.next("segment");
+        s.i = r.integer(ss, "segment node i", 0, n - 1), s.j = r.integer(ss, "segment node j", 0, n - 1);
+        s.shift.x() = r.integer(ss, "segment shift x", -1000000, 1000000);
+        s.shift.y() = r.integer(ss, "segment shift y", -1000000, 1000000);
+        s.l0 = r.num(ss, "segment l0");
+        if (s.l0 <= 0) r.fail("segment l0 = " + show(s.l0) + " must be > 0");
+        s.fiber = r.integer(ss, "segment fiber", 0, 2000000000);
+    }
+    const long nh = r.section("hinges");
+    m.hinges.resize(nh);
+    for (auto& h : m.hinges) {
+        auto ss = r.next("hinge");
+        h.i = r.integer(ss, "hinge node i", 0, n - 1), h.j = r.integer(ss, "hinge node j", 0, n - 1),
+        h.k = r.integer(ss, "hinge node k", 0, n - 1);
+        h.shift1.x() = r.integer(ss, "hinge shift1 x", -1000000, 1000000);
+        h.shift1.y() = r.integer(ss, "hinge shift1 y", -1000000, 1000000);
+        h.shift2.x() = r.integer(ss, "hinge shift2 x", -1000000, 1000000);
+        h.shift2.y() = r.integer(ss, "hinge shift2 y", -1000000, 1000000);
+        h.lt0 = r.num(ss, "hinge lt0");
+        if (h.lt0 <= 0) r.fail("hinge lt0 = " + show(h.lt0) + " must be > 0");
+        h.fiber = r.integer(ss, "hinge fiber", 0, 2000000000);
+    }
+    const long nsn = r.section("supernodes");
+    m.supernodes.resize(nsn);
+    for (auto& s : m.supernodes) {
+        auto ss = r.next("supernode");
+        s.node = r.integer(ss, "supernode node", 0, n - 1);
+        const long k = r.integer(ss, "supernode crossing count", 0, 1000);
+        for (long c = 0; c < k; ++c) s.crossings.push_back(r.integer(ss, "supernode crossing", 0, 2000000000));
+    }
+    if (xout) *xout = x;
+    if (Fout) *Fout = F;
+    return m;
+}
+
+}  // namespace fibernet

@@ -1,0 +1,202 @@
+#include "fibernet/network/network_io.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "fibernet/util/error.hpp"
+
+namespace fibernet {
+
+void write_network(std::ostream& os, const Network& net) {
+    os.precision(17);
+    os << "fibernet-network 1\n";
+    os << "box " << net.L << ' ' << (net.periodic ? "periodic" : "open") << '\n';
+    os << "meta seed " << net.seed << " q " << net.q << " pl " << net.pl << '\n';
+    os << "fibers " << net.fibers.size() << '\n';
+    for (const auto& f : net.fibers)
+        os << f.start.x() << ' ' << f.start.y() << ' ' << f.theta << ' ' << f.length << '\n';
+    os << "crossings " << net.crossings.size() << '\n';
+    for (const auto& c : net.crossings)
+        os << c.f1 << ' ' << c.f2 << ' ' << c.s1 << ' ' << c.s2 << ' ' << c.image.x() << ' ' << c.image.y() << ' '
+           << (c.crosslink ? 1 : 0) << '\n';
+}
+
+namespace {
+struct LineReader {
+    std::istream& is;
+    std::string source;
+    int line = 0;
+    std::string text;
+
+    std::string where() const { return source + ":" + std::to_string(line); }
+    [[noreturn]] void fail(const std::string& msg) const { throw InputError(where() + ": " + msg); }
+
+    // Next non-empty, non-comment line as a token stream.
+    std::istringstream next(const std::string& expecting) {
+        while (std::getline(is, text)) {
+            ++line;
+            auto p = text.find_first_not_of(" \t\r");
+            if (p == std::string::npos || text[p] == '#') continue;
+            return std::istringstream(text);
+        }
+        ++line;
+        fail("unexpected end of file, expected " + expecting);
+    }
+    void expect_end(std::istringstream& ss) {
+        std::string extra;
+        if (ss >> extra) fail("unexpected extra field '" + extra + "' in line '" + text + "'");
+    }
+    double number(std::istringstream& ss, const std::string& name) {
+        std::string tok;
+        if (!(ss >> tok)) fail("missing " + name + " in line '" + text + "'");
+        char* end = nullptr;
+        double v = std::strtod(tok.c_str(), &end);
+        if (end == tok.c_str() || *end != '\0') fail(name + " = '" + tok + "' is not a number");
+        if (!std::isfinite(v)) fail(name + " = " + tok + " is not a finite number");
+        return v;
+    }
+    long integer(std::istringstream& ss, const std::string& name, long lo, long hi) {
+        std::string tok;
+        if (!(ss >> tok)) fail("missing " + name + " in line '" + text + "'");
+        char* end = nullptr;
+        long v = std::strtol(tok.c_str(), &end, 10);
+        if (end == tok.c_str() || *end != '\0') fail(name + " = '" + tok + "' is not an integer");
+        if (v < lo || v > hi) fail(name + " = " + tok + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        return v;
+    }
+    void keyword(std::istringstream& ss, const std::string& kw) {
+        std::string tok;
+        if (!(ss >> tok) || tok != kw) fail("expected '" + kw + "', found '" + text + "'");
+    }
+};
+}  // namespace
+
+Network read_network(std::istream& is, const std::string& source) {
+    LineReader r{is, source};
+    Network net;
+    {
+        auto ss = r.next("header 'fibernet-network 1'");
+        r.keyword(ss, "fibernet-network");
+        r.integer(ss, "format version", 1, 1);
+        r.expect_end(ss);
+    }
+    {
+        auto ss = r.next("'box L periodic|open'");
+        r.keyword(ss, "box");
+        net.L = r.number(ss, "box side L");
+        if (net.L <= 0) r.fail("box side L = " + show(net.L) + " must be > 0");
+        std::string kind;
+        ss >> kind;
+        if (kind != "periodic" && kind != "open") r.fail("box kind '" + kind + "' must be 'periodic' or 'open'");
+        net.periodic = kind == "periodic";
+        r.expect_end(ss);
+    }
+    auto ss = r.next("'meta ...' or 'fibers N'");
+    std::string kw;
+    ss >> kw;
+    if (kw == "meta") {
+        std::string key;
+        while (ss >> key) {
+            if (key == "seed") {
+                std::string tok;
+                ss >> tok;
+                net.seed = std::strtoull(tok.c_str(), nullptr, 10);
+            } else if (key == "q") {
+                net.q = r.number(ss, "meta q");
+            } else if (key == "pl") {
+                net.pl = r.number(ss, "meta pl");
+            } else {
+                r.fail("unknown meta key '" + key + "'");
+            }
+        }
+        ss = r.next("'fibers N'");
+        ss >> kw;
+    }
+    if (kw != "fibers") r.fail("expected 'fibers N', found '" + r.text + "'");
+    const long nf = r.integer(ss, "fiber count", 0, 100000000);
+    r.expect_end(ss);
+    net.fibers.resize(nf);
+    for (long i = 0; i < nf; ++i) {
+        auto ls = r.next("fiber " + std::to_string(i));
+        Fiber& f = net.fibers[i];
+        f.start.x() = r.number(ls, "fiber x0");
+        f.start.y() = r.number(ls, "fiber y0");
+        f.theta = r.number(ls, "fiber theta");
+        f.length = r.number(ls, "fiber length");
+        if (f.length <= 0) r.fail("fiber length = " + show(f.length) + " must be > 0");
+        if (net.periodic && 2 * f.length >= net.L)
+            r.fail("fiber length = " + show(f.length) + " must be < L/2 = " + show(net.L / 2) + " in a periodic box");
+        r.expect_end(ls);
+    }
+    {
+        auto cs = r.next("'crossings M'");
+        r.keyword(cs, "crossings");
+        const long nc = r.integer(cs, "crossing count", 0, 1000000000);
+        r.expect_end(cs);
+        net.crossings.resize(nc);
+        for (long k = 0; k < nc; ++k) {
+            auto ls = r.next("crossing " + std::to_string(k));
+            Crossing& c = net.crossings[k];
+            c.f1 = static_cast<int>(r.integer(ls, "crossing f1", 0, nf - 1));
+            c.f2 = static_cast<int>(r.integer(ls, "crossing f2", 0, nf - 1));
+            if (c.f1 == c.f2) r.fail("crossing joins fiber " + std::to_string(c.f1) + " to itself");
+            c.s1 = r.number(ls, "crossing s1");
+            c.s2 = r.number(ls, "crossing s2");
+            if (c.s1 < 0 || c.s1 > net.fibers[c.f1].length)
+                r.fail("crossing s1 = " + show(c.s1) + " lies outside fiber " + std::to_string(c.f1));
+            if (c.s2 < 0 || c.s2 > net.fibers[c.f2].length)
+                r.fail("crossing s2 = " + show(c.s2) + " lies outside fiber " + std::to_string(c.f2));
+            c.image.x() = static_cast<int>(r.integer(ls, "crossing image x", -1000000, 1000000));
+            c.image.y() = static_cast<int>(r.integer(ls, "crossing image y", -1000000, 1000000));
+            if (!net.periodic && (c.image.x() != 0 || c.image.y() != 0))
+                r.fail("crossing image must be 0 0 in an open box");
+            c.crosslink = r.integer(ls, "crossing crosslink flag", 0, 1) == 1;
+            r.expect_end(ls);
+            // The two arc positions must name the same point (within round-off of the geometry).
+            const Eigen::Vector2d p1 = net.fibers[c.f1].point(c.s1);
+            const Eigen::Vector2d p2 = net.fibers[c.f2].point(c.s2) + net.L * c.image.cast<double>();
+            if ((p1 - p2).norm() > 1e-8 * std::max(1.0, net.L))
+                r.fail("crossing " + std::to_string(k) + " points on fibers " + std::to_string(c.f1) + " and " +
+                       std::to_string(c.f2) + " are " + show((p1 - p2).norm()) + " apart (must coincide)");
+        }
+    }
+    std::string rest;
+    while (std::getline(is, rest)) {
+        ++r.line;
+        if (rest.find_first_not_of(" \t\r") != std::string::npos) r.fail("unexpected content after the crossings: '" + rest + "'");
+    }
+    return net;
+}
+
+void write_file_atomic(const std::string& path, const std::string& content) {
+    const std::string tmp = path + ".tmp";
+    {
+        std::ofstream os(tmp, std::ios::binary);
+        if (!os) throw InputError("cannot open output file '" + path + "' for writing");
+        os << content;
+        if (!os) {
+            std::remove(tmp.c_str());
+            throw std::runtime_error("failed writing '" + path + "'");
+        }
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        std::remove(tmp.c_str());
+        throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "'");
+    }
+}
+
+void save_network(const Network& net, const std::string& path) {
+    std::ostringstream os;
+    write_network(os, net);
+    write_file_atomic(path, os.str());
+}
+
+Network load_network(const std::string& path) {
+    std::ifstream is(path);
+    if (!is) throw InputError("network file '" + path + "' cannot be opened");
+    return read_network(is, path);
+}
+
+}  // namespace fibernet

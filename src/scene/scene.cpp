@@ -1,0 +1,164 @@
+#include "fibernet/scene/scene.hpp"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "fibernet/network/network_io.hpp"
+#include "fibernet/util/error.hpp"
+
+namespace fibernet {
+
+void Scene::check() const {
+    if (network_file.empty()) mikado.check(source);
+    discretization.check(source);
+    check_value(true, gamma, source, "gamma", "");
+    check_value(solver.tol > 0, solver.tol, source, "solver.tol", "must be > 0");
+    check_value(solver.max_iter >= 1, solver.max_iter, source, "solver.max_iter", "must be >= 1");
+}
+
+namespace {
+std::string type_name(toml::node_type t) {
+    switch (t) {
+        case toml::node_type::string: return "a string";
+        case toml::node_type::integer: return "an integer";
+        case toml::node_type::floating_point: return "a float";
+        case toml::node_type::boolean: return "a boolean";
+        case toml::node_type::array: return "an array";
+        case toml::node_type::table: return "a table";
+        default: return "a date or time";
+    }
+}
+
+struct TableReader {
+    const toml::table& t;
+    std::string where;  // "file: [table]"
+    std::set<std::string> known;
+
+    template <class T>
+    bool get(const std::string& key, T& out) {
+        known.insert(key);
+        const toml::node* n = t.get(key);
+        if (!n) return false;
+        if constexpr (std::is_same_v<T, double>) {
+            if (auto v = n->value<double>()) return out = *v, true;
+        } else if constexpr (std::is_same_v<T, bool>) {
+            if (auto v = n->value_exact<bool>()) return out = *v, true;
+        } else if constexpr (std::is_same_v<T, std::string>) {
+            if (auto v = n->value_exact<std::string>()) return out = *v, true;
+        } else {
+            if (auto v = n->value_exact<int64_t>()) return out = static_cast<T>(*v), true;
+        }
+        throw InputError(where + "." + key + " has the wrong type (" + type_name(n->type()) + ")");
+    }
+    void finish() const {
+        for (const auto& [k, v] : t)
+            if (!known.count(std::string(k.str())))
+                throw InputError(where + ": unknown key '" + std::string(k.str()) + "'");
+    }
+};
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& source) {
+    Scene s;
+    s.source = source;
+    toml::table root;
+    try {
+        root = toml::parse(text, source);
+    } catch (const toml::parse_error& e) {
+        std::ostringstream os;
+        os << source << ":" << e.source().begin.line << ": " << e.description();
+        throw InputError(os.str());
+    }
+    static const std::set<std::string> tables = {"network", "model", "load", "solver"};
+    for (const auto& [k, v] : root) {
+        if (!tables.count(std::string(k.str())) || !v.is_table())
+            throw InputError(source + ": unknown table or key '" + std::string(k.str()) +
+                             "' (expected [network], [model], [load], [solver])");
+    }
+    auto table = [&](const char* name) -> const toml::table& {
+        static const toml::table empty;
+        auto* t = root.get_as<toml::table>(name);
+        return t ? *t : empty;
+    };
+    {
+        TableReader r{table("network"), source + ": [network]"};
+        r.get("L", s.mikado.L);
+        r.get("q", s.mikado.q);
+        r.get("pl", s.mikado.pl);
+        int64_t seed = static_cast<int64_t>(s.mikado.seed);
+        if (r.get("seed", seed)) {
+            if (seed < 0) throw InputError(source + ": [network].seed = " + std::to_string(seed) + " must be >= 0");
+            s.mikado.seed = static_cast<std::uint64_t>(seed);
+        }
+        r.get("periodic", s.mikado.periodic);
+        r.get("file", s.network_file);
+        r.finish();
+    }
+    {
+        TableReader r{table("model"), source + ": [model]"};
+        std::string scheme = to_string(s.discretization.scheme);
+        if (r.get("scheme", scheme)) {
+            try {
+                s.discretization.scheme = parse_scheme(scheme);
+            } catch (const InputError& e) {
+                throw InputError(source + ": [model].scheme: " + e.what());
+            }
+        }
+        r.get("n_seg", s.discretization.n_seg);
+        r.get("h", s.discretization.h);
+        r.get("a", s.discretization.aspect_ratio);
+        r.get("fiber_length", s.discretization.fiber_length);
+        r.known.insert("prune");
+        if (auto* arr = r.t.get_as<toml::array>("prune")) {
+            for (const auto& el : *arr) {
+                auto v = el.value_exact<std::string>();
+                if (v && *v == "dangling") s.prune.dangling = true;
+                else if (v && *v == "nonspanning") s.prune.nonspanning = true;
+                else throw InputError(source + ": [model].prune has an unknown entry (expected \"dangling\", \"nonspanning\")");
+            }
+        } else if (r.t.get("prune")) {
+            throw InputError(source + ": [model].prune must be an array of strings");
+        }
+        r.finish();
+    }
+    {
+        TableReader r{table("load"), source + ": [load]"};
+        std::string strain = to_string(s.strain);
+        if (r.get("strain", strain)) {
+            try {
+                s.strain = parse_strain_kind(strain);
+            } catch (const InputError& e) {
+                throw InputError(source + ": [load].strain: " + e.what());
+            }
+        }
+        r.get("gamma", s.gamma);
+        r.finish();
+    }
+    {
+        TableReader r{table("solver"), source + ": [solver]"};
+        r.get("name", s.solver.name);
+        r.get("tol", s.solver.tol);
+        r.get("max_iter", s.solver.max_iter);
+        r.finish();
+    }
+    s.check();
+    return s;
+}
+
+Scene load_scene(const std::string& path) {
+    std::ifstream is(path);
+    if (!is) throw InputError("scene file '" + path + "' cannot be opened");
+    std::stringstream ss;
+    ss << is.rdbuf();
+    return parse_scene(ss.str(), path);
+}
+
+Network scene_network(const Scene& s) {
+    Network net = s.network_file.empty() ? generate_mikado(s.mikado) : load_network(s.network_file);
+    if (s.prune.dangling || s.prune.nonspanning) net = prune(net, s.prune);
+    return net;
+}
+
+}  // namespace fibernet
