@@ -1,0 +1,78 @@
+// End-to-end checks of the `fibernet` executable: outputs, exit codes, and bad input (exit 2, no output file).
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace {
+std::string tmpdir() {
+    static std::string d = [] {
+        char tmpl[] = "/tmp/fibernet_cli_XXXXXX";
+        return std::string(mkdtemp(tmpl));
+    }();
+    return d;
+}
+int run(const std::string& args) {
+    const std::string cmd = std::string(FIBERNET_EXE) + " " + args + " >" + tmpdir() + "/stdout 2>" + tmpdir() + "/stderr";
+    const int rc = std::system(cmd.c_str());
+    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+std::string slurp(const std::string& p) {
+    std::ifstream is(p);
+    return std::string((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
+}
+bool exists(const std::string& p) { return std::ifstream(p).good(); }
+}  // namespace
+
+TEST_CASE("cli: generate and export write documented files", "[cli]") {
+    const std::string net = tmpdir() + "/net.txt", model = tmpdir() + "/model.txt";
+    REQUIRE(run("generate --L 4 --q 5 --pl 1 --seed 1 -o " + net) == 0);
+    CHECK(slurp(net).rfind("fibernet-network 1\n", 0) == 0);
+    REQUIRE(run("export --network " + net + " --scheme even -o " + model) == 0);
+    CHECK(slurp(model).rfind("fibernet-model 1\n", 0) == 0);
+    REQUIRE(run("info --network " + net) == 0);
+    CHECK(slurp(tmpdir() + "/stdout").find("\"supernodes\"") != std::string::npos);
+}
+
+TEST_CASE("cli: bad input exits 2, names the value and writes no output file", "[cli][input]") {
+    const std::string out = tmpdir() + "/should_not_exist.txt";
+    struct Case {
+        std::string args, message;
+    };
+    const Case cases[] = {
+        {"generate --q -3", "q (density) = -3"},
+        {"generate --q 0", "q (density) = 0"},
+        {"generate --pl 1.5", "pl (crosslink probability) = 1.5"},
+        {"generate --pl nan", "pl (crosslink probability) = nan"},
+        {"generate --L 1.5", "L (box side in fiber lengths) = 1.5"},
+        {"generate --L inf", "is not a finite number"},
+        {"export --nseg 0", "n_seg = 0"},
+        {"export --a -1", "a (aspect ratio) = -1"},
+        {"export --scheme odd", "'odd'"},
+        {"generate --frobnicate", "frobnicate"},
+        {"generate --q abc", "abc"},
+        {"export --network /nonexistent.net", "nonexistent"},
+    };
+    for (const auto& c : cases) {
+        std::remove(out.c_str());
+        INFO(c.args);
+        CHECK(run(c.args + " -o " + out) == 2);
+        CHECK(slurp(tmpdir() + "/stderr").find(c.message) != std::string::npos);
+        CHECK(!exists(out));
+    }
+    // A malformed network file.
+    const std::string bad = tmpdir() + "/bad.net";
+    std::ofstream(bad) << "fibernet-network 1\nbox 10 open\nfibers 1\n0 0 zero 1\ncrossings 0\n";
+    CHECK(run("export --network " + bad + " -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find(bad + ":4: fiber theta = 'zero' is not a number") != std::string::npos);
+    CHECK(!exists(out));
+    // A malformed scene.
+    const std::string scene = tmpdir() + "/bad.toml";
+    std::ofstream(scene) << "[network]\npl = -0.1\n";
+    CHECK(run("generate " + scene + " -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("bad.toml: pl (crosslink probability) = -0.1") != std::string::npos);
+    CHECK(!exists(out));
+}

@@ -1,0 +1,202 @@
+#include <catch2/catch.hpp>
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "fd.hpp"
+#include "fibernet/energy/network_energy.hpp"
+#include "fibernet/model/discretize.hpp"
+#include "fibernet/network/mikado.hpp"
+#include "fibernet/util/random.hpp"
+
+using namespace fibernet;
+
+namespace {
+Model small_model(bool periodic, Scheme scheme, double a = 10, std::uint64_t seed = 3) {
+    MikadoParams p;
+    p.L = 3.2, p.q = 3, p.pl = 0.7, p.seed = seed, p.periodic = periodic;
+    DiscretizationParams d;
+    d.scheme = scheme, d.n_seg = 4, d.h = 3.0, d.aspect_ratio = a;
+    return discretize(generate_mikado(p), d);
+}
+
+Eigen::VectorXd perturbed(const NetworkEnergy& e, double amp, std::uint64_t seed) {
+    Rng rng(seed);
+    Eigen::VectorXd q = e.dofs(e.model().x);
+    for (int i = 0; i < q.size(); ++i) q[i] += amp * (2 * rng.uniform() - 1);
+    return q;
+}
+
+// Checks gradient, Hessian and the three strain derivatives of E(q, F + t dF) against central differences.
+void check_all_derivatives(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
+                           const Eigen::Matrix2d& dF) {
+    EnergyEval ev;
+    Eigen::SparseMatrix<double> H = e.hessian_pattern();
+    e.evaluate(q, F, dF, kGradient | kHessian | kStrain, ev, &H);
+    const Eigen::MatrixXd Hu(H);
+    const Eigen::MatrixXd Hfull = Eigen::MatrixXd(Hu.selfadjointView<Eigen::Upper>());
+    auto val = [&](const Eigen::VectorXd& v) {
+        EnergyEval t;
+        e.evaluate(v, F, dF, kValue, t);
+        return t.energy;
+    };
+    auto grad = [&](const Eigen::VectorXd& v) {
+        EnergyEval t;
+        e.evaluate(v, F, dF, kGradient, t);
+        return t.gradient;
+    };
+    const double h = 1e-6;
+    CHECK(fdtest::rel_err(ev.gradient, fdtest::fd_gradient(val, q, h)) < 1e-6);
+    CHECK(fdtest::rel_err(Hfull, fdtest::fd_jacobian(grad, q, h)) < 1e-6);
+    // Strain: t enters through F(t) = F + t dF (box vectors and clamped nodes).
+    auto at_t = [&](double t, unsigned want) {
+        EnergyEval r;
+        e.evaluate(q, F + t * dF, dF, want, r);
+        return r;
+    };
+    const double ht = 1e-6;
+    const double Et_fd = (at_t(ht, kValue).energy - at_t(-ht, kValue).energy) / (2 * ht);
+    const double Ett_fd = (at_t(ht, kStrain).dE_dt - at_t(-ht, kStrain).dE_dt) / (2 * ht);
+    const Eigen::VectorXd Ext_fd = (at_t(ht, kGradient).gradient - at_t(-ht, kGradient).gradient) / (2 * ht);
+    CHECK(ev.dE_dt == Approx(Et_fd).epsilon(1e-6).margin(1e-8 * std::abs(ev.d2E_dt2)));
+    CHECK(ev.d2E_dt2 == Approx(Ett_fd).epsilon(1e-6));
+    CHECK(fdtest::rel_err(ev.d2E_dqdt, Ext_fd) < 1e-6);
+}
+}  // namespace
+
+TEST_CASE("network energy: zero in the rest state", "[energy]") {
+    for (Scheme s : {Scheme::Seed, Scheme::Even}) {
+        Model m = small_model(true, s);
+        NetworkEnergy e(m);
+        EnergyEval ev;
+        e.evaluate(e.dofs(m.x), Eigen::Matrix2d::Identity(), strain_direction(StrainKind::Shear), kGradient | kStrain, ev);
+        // Round-off only: cos phi of collinear segments is 1 to within 1e-16.
+        CHECK(std::abs(ev.energy) < 1e-12);
+        CHECK(ev.gradient.cwiseAbs().maxCoeff() < 1e-9);
+        CHECK(std::abs(ev.dE_dt) < 1e-9);
+    }
+}
+
+TEST_CASE("network energy: derivatives match finite differences in a sheared periodic box", "[energy][gradient][hessian]") {
+    for (Scheme s : {Scheme::Seed, Scheme::Even}) {
+        Model m = small_model(true, s);
+        // The test is only meaningful if segments and hinges cross the periodic boundary.
+        int crossing = 0;
+        for (const auto& seg : m.segments) crossing += seg.shift != Eigen::Vector2i::Zero();
+        REQUIRE(crossing > 0);
+        NetworkEnergy e(m);
+        const Eigen::Matrix2d F = deformation(StrainKind::Shear, 0.3);
+        INFO("scheme " << to_string(s));
+        check_all_derivatives(e, perturbed(e, 0.05, 11), F, strain_direction(StrainKind::Shear));
+        check_all_derivatives(e, perturbed(e, 0.05, 12), F, strain_direction(StrainKind::UniaxialX));
+        check_all_derivatives(e, perturbed(e, 0.05, 13), F, strain_direction(StrainKind::Isotropic));
+    }
+}
+
+TEST_CASE("network energy: derivatives at large bending angles", "[energy][gradient][hessian]") {
+    Model m = small_model(true, Scheme::Even, 1.0);
+    NetworkEnergy e(m);
+    // Large random moves of nodes spaced ~1 apart give hinge angles up to ~pi; the softcore keeps E finite.
+    const Eigen::VectorXd q = perturbed(e, 0.45, 21);
+    check_all_derivatives(e, q, deformation(StrainKind::Shear, -0.2), strain_direction(StrainKind::Shear));
+}
+
+TEST_CASE("network energy: derivatives on the softcore branch", "[energy][gradient][hessian]") {
+    Model m = small_model(true, Scheme::Even);
+    NetworkEnergy e(m);
+    const Eigen::Matrix2d F = deformation(StrainKind::Shear, 0.1);
+    Eigen::VectorXd x = e.positions(perturbed(e, 0.01, 31), F);
+    // Compress some segments to eps = -0.97 and -0.99 (below eps* = -0.95): move node j towards node i.
+    int compressed = 0;
+    for (size_t k = 0; k < m.segments.size() && compressed < 4; k += 7) {
+        const Segment& s = m.segments[k];
+        const Eigen::Vector2d d = x.segment<2>(2 * s.j) - x.segment<2>(2 * s.i) + F * m.box.B0() * s.shift.cast<double>();
+        const double target = (compressed % 2 ? 0.03 : 0.01) * s.l0;
+        x.segment<2>(2 * s.j) -= d - target * d.normalized();
+        ++compressed;
+    }
+    const Eigen::VectorXd q = e.dofs(x);
+    EnergyEval ev;
+    e.evaluate(q, F, F, kValue, ev);
+    REQUIRE(std::isfinite(ev.energy));
+    check_all_derivatives(e, q, F, strain_direction(StrainKind::Shear));
+}
+
+TEST_CASE("network energy: open box with clamped nodes, strain moves the clamps", "[energy][gradient][hessian]") {
+    Model m = small_model(false, Scheme::Seed);
+    for (int i = 0; i < m.num_nodes(); i += 5) m.fixed[i] = 1;
+    NetworkEnergy e(m);
+    REQUIRE(e.num_dofs() < 2 * m.num_nodes());
+    check_all_derivatives(e, perturbed(e, 0.05, 41), deformation(StrainKind::Shear, 0.05),
+                          strain_direction(StrainKind::Shear));
+}
+
+TEST_CASE("network energy: invariant under rigid motions of an open network", "[energy]") {
+    Model m = small_model(false, Scheme::Seed);
+    NetworkEnergy e(m);
+    const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+    const Eigen::VectorXd q = perturbed(e, 0.1, 51);
+    EnergyEval ev;
+    e.evaluate(q, I, I, kValue, ev);
+    const double E0 = ev.energy;
+    REQUIRE(E0 > 1e-3);
+    const double th = 0.7;
+    Eigen::Matrix2d R;
+    R << std::cos(th), -std::sin(th), std::sin(th), std::cos(th);
+    Eigen::VectorXd x = e.positions(q, I);
+    for (int i = 0; i < m.num_nodes(); ++i) x.segment<2>(2 * i) = R * x.segment<2>(2 * i).eval() + Eigen::Vector2d(3.3, -1.7);
+    e.evaluate(e.dofs(x), I, I, kValue, ev);
+    CHECK(ev.energy == Approx(E0).epsilon(1e-10));
+}
+
+TEST_CASE("network energy: moving a node through a box vector with its image shifts adjusted changes nothing", "[energy]") {
+    Model m = small_model(true, Scheme::Seed);
+    const Eigen::Matrix2d F = deformation(StrainKind::Shear, 0.2);
+    NetworkEnergy e0(m);
+    const Eigen::VectorXd q = perturbed(e0, 0.05, 61);
+    EnergyEval ev0;
+    e0.evaluate(q, F, strain_direction(StrainKind::Shear), kGradient | kStrain, ev0);
+    Eigen::VectorXd x = e0.positions(q, F);
+    Model moved = m;
+    const Eigen::Vector2i n(1, -1);
+    for (int p = 0; p < m.num_nodes(); p += 3) {
+        x.segment<2>(2 * p) += F * m.box.B0() * n.cast<double>();
+        moved.x.segment<2>(2 * p) += m.box.B0() * n.cast<double>();
+        for (auto& s : moved.segments) {
+            if (s.i == p) s.shift += n;
+            if (s.j == p) s.shift -= n;
+        }
+        for (auto& h : moved.hinges) {
+            if (h.i == p) h.shift1 += n;
+            if (h.j == p) h.shift1 -= n, h.shift2 += n;
+            if (h.k == p) h.shift2 -= n;
+        }
+    }
+    NetworkEnergy e1(moved);
+    EnergyEval ev1;
+    e1.evaluate(e1.dofs(x), F, strain_direction(StrainKind::Shear), kGradient | kStrain, ev1);
+    CHECK(ev1.energy == Approx(ev0.energy).epsilon(1e-10));
+    // The strain derivative at fixed positions depends on the image chosen for a node unless the force on it
+    // vanishes: dE/dt changes by -g_p . (dF B0 n) for each moved node p (exact identity; zero at equilibrium).
+    double expected = ev0.dE_dt;
+    const Eigen::Vector2d c = strain_direction(StrainKind::Shear) * m.box.B0() * n.cast<double>();
+    for (int p = 0; p < m.num_nodes(); p += 3)
+        expected -= ev0.gradient.segment<2>(e0.dof(p, 0)).dot(c);
+    CHECK(ev1.dE_dt == Approx(expected).epsilon(1e-8));
+    CHECK((ev1.gradient - ev0.gradient).cwiseAbs().maxCoeff() < 1e-8 * ev0.gradient.cwiseAbs().maxCoeff());
+}
+
+TEST_CASE("network energy: per-element PSD projection gives a positive semidefinite Hessian", "[energy][hessian]") {
+    Model m = small_model(true, Scheme::Even, 10, 5);
+    NetworkEnergy e(m);
+    const Eigen::VectorXd q = perturbed(e, 0.3, 71);
+    EnergyEval ev;
+    Eigen::SparseMatrix<double> H = e.hessian_pattern();
+    e.evaluate(q, deformation(StrainKind::Shear, 0.2), Eigen::Matrix2d::Zero(), kHessian, ev, &H);
+    Eigen::MatrixXd Hd = Eigen::MatrixXd(Eigen::MatrixXd(H).selfadjointView<Eigen::Upper>());
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> exact(Hd);
+    REQUIRE(exact.eigenvalues().minCoeff() < -1e-6);  // the exact Hessian of this state is indefinite
+    e.evaluate(q, deformation(StrainKind::Shear, 0.2), Eigen::Matrix2d::Zero(), kHessian | kProjectPSD, ev, &H);
+    Hd = Eigen::MatrixXd(Eigen::MatrixXd(H).selfadjointView<Eigen::Upper>());
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> proj(Hd);
+    CHECK(proj.eigenvalues().minCoeff() > -1e-9 * proj.eigenvalues().maxCoeff());
+}

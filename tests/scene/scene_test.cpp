@@ -1,0 +1,41 @@
+#include <catch2/catch.hpp>
+
+#include "fibernet/scene/scene.hpp"
+#include "fibernet/util/error.hpp"
+
+using namespace fibernet;
+
+TEST_CASE("scene: values are read and defaults kept", "[scene]") {
+    const Scene s = parse_scene(
+        "[network]\nL = 5\nq = 6.5\npl = 0.5\nseed = 3\n[model]\nscheme = \"even\"\nh = 0.5\na = 100\n"
+        "prune = [\"dangling\"]\n[load]\nstrain = \"isotropic\"\ngamma = 0.01\n[solver]\ntol = 1e-9\n",
+        "s.toml");
+    CHECK(s.mikado.L == 5);
+    CHECK(s.mikado.q == 6.5);
+    CHECK(s.mikado.pl == 0.5);
+    CHECK(s.mikado.seed == 3);
+    CHECK(s.mikado.periodic);
+    CHECK(s.discretization.scheme == Scheme::Even);
+    CHECK(s.discretization.h == 0.5);
+    CHECK(s.discretization.aspect_ratio == 100);
+    CHECK(s.discretization.n_seg == 10);
+    CHECK(s.prune.dangling);
+    CHECK(!s.prune.nonspanning);
+    CHECK(s.strain == StrainKind::Isotropic);
+    CHECK(s.gamma == 0.01);
+    CHECK(s.solver.tol == 1e-9);
+    CHECK(s.solver.name == "newton");
+}
+
+TEST_CASE("scene: bad scenes name the file, key and value", "[scene][input]") {
+    CHECK_THROWS_WITH(parse_scene("[network]\nq = -2\n", "s.toml"), Catch::Contains("s.toml: q (density) = -2"));
+    CHECK_THROWS_WITH(parse_scene("[network]\npl = 2\n", "s.toml"), Catch::Contains("pl (crosslink probability) = 2"));
+    CHECK_THROWS_WITH(parse_scene("[network]\nqq = 2\n", "s.toml"), Catch::Contains("unknown key 'qq'"));
+    CHECK_THROWS_WITH(parse_scene("[netwrk]\n", "s.toml"), Catch::Contains("'netwrk'"));
+    CHECK_THROWS_WITH(parse_scene("[network]\nq = \"high\"\n", "s.toml"), Catch::Contains("q has the wrong type"));
+    CHECK_THROWS_WITH(parse_scene("[network]\nq = nan\n", "s.toml"), Catch::Contains("q (density) = nan"));
+    CHECK_THROWS_WITH(parse_scene("[model]\nscheme = \"odd\"\n", "s.toml"), Catch::Contains("'odd'"));
+    CHECK_THROWS_WITH(parse_scene("[model]\nn_seg = 0\n", "s.toml"), Catch::Contains("n_seg = 0"));
+    CHECK_THROWS_WITH(parse_scene("[network\n", "s.toml"), Catch::Contains("s.toml:1"));
+    CHECK_THROWS_AS(load_scene("/nonexistent.toml"), InputError);
+}
