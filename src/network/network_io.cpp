@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <sys/stat.h>
 
 #include "fibernet/util/error.hpp"
 
@@ -171,6 +172,13 @@ Network read_network(std::istream& is, const std::string& source) {
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {
+    struct stat st;
+    if (stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+        // A device or pipe (/dev/null, /dev/stdout): write straight to it; renaming over it would replace it.
+        std::ofstream os(path, std::ios::binary);
+        if (!(os << content)) throw InputError("cannot write output '" + path + "'");
+        return;
+    }
     const std::string tmp = path + ".tmp";
     {
         std::ofstream os(tmp, std::ios::binary);

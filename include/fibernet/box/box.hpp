@@ -2,6 +2,8 @@
 // Periodic (or open) square box with an affine deformation F (DESIGN.md §2, "Periodic box and strain").
 // Box vectors are the columns of B = F B0, B0 = L I. A segment's vector is d = x_j - x_i + B n_ij.
 #include <Eigen/Core>
+#include <Eigen/LU>  // determinant
+#include <cmath>
 #include <string>
 
 namespace fibernet {
