@@ -46,5 +46,11 @@ using Registrar = std::function<void(CLI::App&)>;
 void register_generate(CLI::App& app);
 void register_export(CLI::App& app);
 void register_info(CLI::App& app);
+void register_rigidity(CLI::App& app);
+void register_compare(CLI::App& app);
+void register_percolation(CLI::App& app);
+void register_modulus(CLI::App& app);
+void register_relax(CLI::App& app);
+void register_wet(CLI::App& app);
 
 }  // namespace fibernet::cli

@@ -15,6 +15,12 @@ int main(int argc, char** argv) {
     cli::register_generate(app);
     cli::register_export(app);
     cli::register_info(app);
+    cli::register_rigidity(app);
+    cli::register_compare(app);
+    cli::register_percolation(app);
+    cli::register_modulus(app);
+    cli::register_relax(app);
+    cli::register_wet(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <toml++/toml.h>
 
+#include "fibernet/energy/capillary.hpp"
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/util/error.hpp"
 
@@ -16,6 +17,17 @@ void Scene::check() const {
     check_value(true, gamma, source, "gamma", "");
     check_value(solver.tol > 0, solver.tol, source, "solver.tol", "must be > 0");
     check_value(solver.max_iter >= 1, solver.max_iter, source, "solver.max_iter", "must be >= 1");
+    check_value(wet.beta >= 0, wet.beta, source, "[wet].beta", "must be >= 0");
+    check_value(wet.fraction >= 0 && wet.fraction <= 1, wet.fraction, source, "[wet].fraction", "must lie in [0, 1]");
+    if (wet.crossings != "all" && wet.crossings != "free" && wet.crossings != "fraction")
+        throw InputError(source + ": [wet].crossings = '" + wet.crossings + "' is unknown (expected all, free or fraction)");
+    if (!wet.law.empty()) {
+        try {
+            CapillaryLaw::read(wet.law);  // a malformed table names its file and row
+        } catch (const InputError& e) {
+            throw InputError(source + ": [wet].law: " + e.what());
+        }
+    }
 }
 
 namespace {
@@ -71,7 +83,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         os << source << ":" << e.source().begin.line << ": " << e.description();
         throw InputError(os.str());
     }
-    static const std::set<std::string> tables = {"network", "model", "load", "solver"};
+    static const std::set<std::string> tables = {"network", "model", "load", "solver", "wet"};
     for (const auto& [k, v] : root) {
         if (!tables.count(std::string(k.str())) || !v.is_table())
             throw InputError(source + ": unknown table or key '" + std::string(k.str()) +
@@ -141,6 +153,19 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         r.get("name", s.solver.name);
         r.get("tol", s.solver.tol);
         r.get("max_iter", s.solver.max_iter);
+        r.finish();
+    }
+    {
+        TableReader r{table("wet"), source + ": [wet]"};
+        r.get("beta", s.wet.beta);
+        r.get("law", s.wet.law);
+        r.get("crossings", s.wet.crossings);
+        r.get("fraction", s.wet.fraction);
+        int64_t seed = static_cast<int64_t>(s.wet.seed);
+        if (r.get("seed", seed)) {
+            if (seed < 0) throw InputError(source + ": [wet].seed = " + std::to_string(seed) + " must be >= 0");
+            s.wet.seed = static_cast<std::uint64_t>(seed);
+        }
         r.finish();
     }
     s.check();

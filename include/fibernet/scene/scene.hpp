@@ -18,6 +18,16 @@ struct SolverSettings {
     int max_iter = 500;
 };
 
+// [wet] (docs/formats.md, "Wet scenes"; issue 6): capillary bridges for `fibernet wet`. Plain values here; the wet
+// module (include/fibernet/wet/) interprets them.
+struct WetSettings {
+    double beta = 1;            // adhesion energy per unit length of a two-fiber bundle (>= 0)
+    std::string law;            // tabulated law file "alpha_deg value" (empty: E = -beta l cos^2 alpha)
+    std::string crossings = "all";  // which crossings are wet: all | free | fraction
+    double fraction = 1;        // crossings = "fraction": probability that a crossing is wet, in [0, 1]
+    std::uint64_t seed = 1;     // draws of the wet fraction
+};
+
 struct Scene {
     std::string source = "defaults";  // where the values came from (file name), for messages
     MikadoParams mikado;               // used unless network_file is set
@@ -27,6 +37,7 @@ struct Scene {
     StrainKind strain = StrainKind::Shear;
     double gamma = 0;                  // strain parameter t of F(t)
     SolverSettings solver;
+    WetSettings wet;
 
     void check() const;  // throws InputError naming the bad value and the scene's source
 };

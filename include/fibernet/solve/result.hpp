@@ -6,7 +6,7 @@
 namespace fibernet {
 
 enum class SolveStatus {
-    Converged,          // max|g| <= tol
+    Converged,          // max|g| <= tol (Newton also: at the round-off floor with progress stopped; see message)
     IterationLimit,     // budget spent before tol
     LineSearchFailed,   // no acceptable step along a descent direction
     NonFinite,          // NaN/inf energy or gradient met
@@ -28,6 +28,7 @@ struct SolveResult {
     int evaluations = 0;                // energy/gradient evaluations
     double energy = 0;
     double grad_max = 0;                // max |g| at the returned state
+    double grad_floor = 0;              // round-off floor of max |g| at the returned state (0: not estimated)
     SolveTimings timings;
 
     bool converged() const { return status == SolveStatus::Converged; }

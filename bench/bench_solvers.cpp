@@ -1,0 +1,303 @@
+// Work-precision benchmark of the solver suite (issue 5, part 2), and the stability map (part 3).
+//
+// Mode "wp" (default): every solver minimizes the same sheared Mikado networks (sizes L, aspect ratios a, both
+// discretizations) from the affine start q = F x. A wrapper around the objective records every evaluation
+// (wall time, energy, max|g|), so all solvers are measured the same way whatever their internals. Writes
+//   <out>/runs.csv   one row per (network, solver): status, counts, time, final energy error and max|g|
+//   <out>/trace.csv  per (network, solver): time against the running minimum of max|g| and of the relative
+//                    energy error (E - E_best) / |E_best|, E_best the lowest energy any solver found on that network
+// Mode "stability": every solver on a grid of (a, gamma, q, scheme) with a fixed budget; writes <out>/stability.csv.
+// Mode "discretization": the linear shear modulus G of the rest state (stress-free, so no relaxation: one
+// factorization, mechanics/moduli.hpp) for the seed scheme at n_seg in --nseg and the even scheme at h in --h,
+// against the finest even discretization; writes <out>/discretization.csv (G, relative error, nodes per fiber,
+// DOF, seconds for discretize + modulus).
+//
+//   bench_solvers [--mode wp|stability] [--out DIR] [--L 4,8,12] [--q 8] [--a 10,100] [--schemes seed,even]
+//                 [--solvers newton,lbfgs,...] [--gamma 0.05] [--tol 1e-10] [--budget 2,4,8] [--seed 1]
+//                 [--max-iter N] [--rel-tol R] [--verbose]
+// --rel-tol R > 0 sets each network's tolerance to R * max|g| at its start (the force scale grows like a^2 and
+// gamma, so one absolute tol means different things across the stability grid); otherwise --tol applies.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fibernet/box/box.hpp"
+#include "fibernet/energy/network_energy.hpp"
+#include "fibernet/mechanics/moduli.hpp"
+#include "fibernet/model/discretize.hpp"
+#include "fibernet/network/mikado.hpp"
+#include "fibernet/solve/solver.hpp"
+#include "fibernet/solve/solver_suite.hpp"
+
+using namespace fibernet;
+
+namespace {
+
+std::vector<std::string> split(const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream ss(s);
+    std::string item;
+    while (std::getline(ss, item, ','))
+        if (!item.empty()) out.push_back(item);
+    return out;
+}
+std::vector<double> split_d(const std::string& s) {
+    std::vector<double> out;
+    for (const auto& x : split(s)) out.push_back(std::stod(x));
+    return out;
+}
+
+struct Sample {
+    double t, energy, gmax;
+    int evals;
+};
+
+// Records every evaluation of the wrapped objective.
+class Recorder : public Objective {
+public:
+    Recorder(Objective& f) : f_(f), t0_(std::chrono::steady_clock::now()) {}
+    int size() const override { return f_.size(); }
+    double value(const Eigen::VectorXd& q) override {
+        ++evals_;
+        return f_.value(q);
+    }
+    double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override {
+        const double e = f_.gradient(q, g);
+        record(e, g);
+        return e;
+    }
+    double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool psd) override {
+        const double e = f_.hessian(q, g, H, psd);
+        record(e, g);
+        return e;
+    }
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return f_.hessian_pattern(); }
+    std::vector<Sample> samples;
+
+private:
+    void record(double e, const Eigen::VectorXd& g) {
+        ++evals_;
+        const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+        const double gm = g.size() ? g.lpNorm<Eigen::Infinity>() : 0.0;
+        if (std::isfinite(e) && std::isfinite(gm)) samples.push_back({t, e, gm, evals_});
+    }
+    Objective& f_;
+    std::chrono::steady_clock::time_point t0_;
+    int evals_ = 0;
+};
+
+struct Run {
+    std::string solver;
+    SolveResult res;
+    std::vector<Sample> samples;
+};
+
+struct Case {
+    double L, q, a, gamma;
+    std::string scheme;
+    int dof = 0;
+    double shortest = 0;
+};
+
+std::string case_id(const Case& c) {
+    std::ostringstream os;
+    os << c.scheme << "_L" << c.L << "_q" << c.q << "_a" << c.a << "_g" << c.gamma;
+    return os.str();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::map<std::string, std::string> arg = {
+        {"mode", "wp"},       {"out", "docs/solvers"}, {"L", "4,8,12"},   {"q", "8"},
+        {"a", "10,100"},      {"schemes", "seed,even"}, {"gamma", "0.05"}, {"tol", "1e-10"},
+        {"budget", "2,4,8"},  {"seed", "1"},           {"max-iter", "100000000"}, {"verbose", "0"},
+        {"solvers", ""},      {"rel-tol", "0"},      {"nseg", "2,3,5,10,20,40"}, {"h", "4,2,1,0.5,0.25,0.125,0.0625"},
+    };
+    for (int i = 1; i < argc; ++i) {
+        std::string k = argv[i];
+        if (k.rfind("--", 0) != 0) {
+            std::cerr << "unexpected argument " << k << "\n";
+            return 2;
+        }
+        k = k.substr(2);
+        if (!arg.count(k)) {
+            std::cerr << "unknown option --" << k << "\n";
+            return 2;
+        }
+        if (k == "verbose") {
+            arg[k] = "1";
+            continue;
+        }
+        if (i + 1 >= argc) {
+            std::cerr << "--" << k << " needs a value\n";
+            return 2;
+        }
+        arg[k] = argv[++i];
+    }
+    std::vector<std::string> solvers = split(arg["solvers"]);
+    if (solvers.empty()) {
+        solvers.push_back("newton");
+        for (const auto& s : suite_solver_names()) solvers.push_back(s);
+    }
+    const std::string mode = arg["mode"], out = arg["out"];
+    const double tol_abs = std::stod(arg["tol"]), rel_tol = std::stod(arg["rel-tol"]);
+    const int max_iter = std::stoi(arg["max-iter"]);
+    const bool verbose = arg["verbose"] == "1";
+    const auto Ls = split_d(arg["L"]), qs = split_d(arg["q"]), as = split_d(arg["a"]), gammas = split_d(arg["gamma"]);
+    const auto budgets = split_d(arg["budget"]);
+    const auto schemes = split(arg["schemes"]);
+    const std::uint64_t seed = std::stoull(arg["seed"]);
+
+    if (mode == "discretization") {
+        std::ofstream os(out + "/discretization.csv");
+        os << "L,q,a,seed,scheme,n_seg,h,fibers,nodes,dof,nodes_per_fiber,shortest_segment,G,G_affine,G_ref,rel_err,"
+              "moduli_ok,seconds_discretize,seconds_modulus\n";
+        for (double L : Ls)
+            for (double q : qs)
+                for (double a : as) {
+                    MikadoParams mp;
+                    mp.L = L, mp.q = q, mp.pl = 1, mp.seed = seed, mp.periodic = true;
+                    const Network net = generate_mikado(mp);
+                    struct Row { std::string scheme; int n_seg; double h; int nodes, dof; double shortest, G, Ga, td, tm; bool ok; };
+                    std::vector<Row> rows;
+                    auto run = [&](Scheme sc, int n_seg, double h) {
+                        DiscretizationParams dp;
+                        dp.scheme = sc, dp.n_seg = n_seg, dp.h = h, dp.aspect_ratio = a;
+                        const auto t0 = std::chrono::steady_clock::now();
+                        const Model model = discretize(net, dp);
+                        const NetworkEnergy e(model);
+                        const auto t1 = std::chrono::steady_clock::now();
+                        const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+                        ModuliInfo info;
+                        const auto m = linear_moduli(e, e.dofs(model.x), I, {shear_mode(I, model.box.area())}, {}, &info);
+                        const auto t2 = std::chrono::steady_clock::now();
+                        Row r{to_string(sc), n_seg, h, model.num_nodes(), e.num_dofs(), summarize(model).shortest_segment,
+                              m[0].value, m[0].affine, std::chrono::duration<double>(t1 - t0).count(),
+                              std::chrono::duration<double>(t2 - t1).count(), m[0].ok};
+                        std::fprintf(stderr, "L %g q %g a %g %s n_seg %d h %g: %d DOF  G %.10g  (%.3fs)\n", L, q, a,
+                                     r.scheme.c_str(), n_seg, h, r.dof, r.G, r.tm);
+                        rows.push_back(r);
+                    };
+                    for (double ns : split_d(arg["nseg"])) run(Scheme::Seed, static_cast<int>(ns), 1.0);
+                    const auto hs = split_d(arg["h"]);
+                    for (double h : hs) run(Scheme::Even, 10, h);
+                    // Reference: the finest even discretization (the smallest h).
+                    double Gref = 0, hmin = 1e300;
+                    for (const auto& r : rows)
+                        if (r.scheme == "even" && r.h < hmin) hmin = r.h, Gref = r.G;
+                    for (const auto& r : rows)
+                        os << L << "," << q << "," << a << "," << seed << "," << r.scheme << "," << r.n_seg << "," << r.h
+                           << "," << net.fibers.size() << "," << r.nodes << "," << r.dof << ","
+                           << double(r.nodes) / net.fibers.size() << "," << r.shortest << "," << std::setprecision(12)
+                           << r.G << "," << r.Ga << "," << Gref << "," << std::setprecision(6)
+                           << std::abs(r.G - Gref) / std::abs(Gref) << "," << r.ok << "," << r.td << "," << r.tm << "\n";
+                    os.flush();
+                }
+        return 0;
+    }
+
+    std::vector<std::pair<Case, double>> cases;  // with the time budget per run
+    for (size_t li = 0; li < Ls.size(); ++li)
+        for (double q : qs)
+            for (double a : as)
+                for (double gamma : gammas)
+                    for (const auto& sc : schemes)
+                        cases.push_back({Case{Ls[li], q, a, gamma, sc}, budgets[std::min(li, budgets.size() - 1)]});
+
+    const bool wp = mode == "wp";
+    std::ofstream runs(out + (wp ? "/runs.csv" : "/stability.csv"));
+    std::ofstream trace;
+    runs << "case,scheme,L,q,a,gamma,dof,shortest_segment,solver,status,iterations,evaluations,factorizations,"
+            "seconds,budget_s,energy,energy_best,rel_energy_err,grad_max,tol,message\n";
+    if (wp) {
+        trace.open(out + "/trace.csv");
+        trace << "case,scheme,L,a,dof,solver,t,evals,grad_min,rel_energy_err\n";
+    }
+    for (auto& [c, budget] : cases) {
+        MikadoParams mp;
+        mp.L = c.L, mp.q = c.q, mp.pl = 1, mp.seed = seed, mp.periodic = true;
+        DiscretizationParams dp;
+        dp.scheme = parse_scheme(c.scheme), dp.aspect_ratio = c.a;
+        const Model model = discretize(generate_mikado(mp), dp);
+        const NetworkEnergy energy(model);
+        const Eigen::Matrix2d F = deformation(StrainKind::Shear, c.gamma);
+        const Eigen::VectorXd q0 = energy.affine_map(energy.dofs(model.x), Eigen::Matrix2d::Identity(), F);
+        c.dof = energy.num_dofs();
+        double tol = tol_abs;
+        if (rel_tol > 0) {
+            StrainedEnergy f0(energy, F);
+            Eigen::VectorXd g0;
+            f0.gradient(q0, g0);
+            tol = rel_tol * g0.lpNorm<Eigen::Infinity>();
+        }
+        c.shortest = summarize(model).shortest_segment;
+        std::vector<Run> rs;
+        for (const auto& name : solvers) {
+            SolverOptions opt;
+            opt.tol = tol, opt.max_iter = max_iter, opt.max_seconds = budget, opt.verbose = verbose;
+            auto solver = make_solver(name, opt);
+            StrainedEnergy obj(energy, F);
+            Recorder rec(obj);
+            Eigen::VectorXd q = q0;
+            Run r;
+            r.solver = name;
+            try {
+                r.res = solver->minimize(rec, q);
+            } catch (const std::exception& e) {
+                r.res.status = SolveStatus::Failed, r.res.solver = name, r.res.message = std::string("exception: ") + e.what();
+                r.res.energy = std::numeric_limits<double>::quiet_NaN();
+            }
+            r.samples = std::move(rec.samples);
+            std::fprintf(stderr, "%-28s %-14s %-18s it %7d  t %7.3fs  E %.15g  max|g| %.2e  %s\n", case_id(c).c_str(),
+                         name.c_str(), to_string(r.res.status).c_str(), r.res.iterations, r.res.timings.total,
+                         r.res.energy, r.res.grad_max, r.res.message.c_str());
+            rs.push_back(std::move(r));
+        }
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& r : rs) {
+            for (const auto& s : r.samples) best = std::min(best, s.energy);
+            if (std::isfinite(r.res.energy)) best = std::min(best, r.res.energy);
+        }
+        const double scale = std::max(std::abs(best), 1e-300);
+        for (const auto& r : rs) {
+            std::string msg = r.res.message;
+            std::replace(msg.begin(), msg.end(), ',', ';');
+            std::replace(msg.begin(), msg.end(), '"', '\'');
+            runs << case_id(c) << "," << c.scheme << "," << c.L << "," << c.q << "," << c.a << "," << c.gamma << ","
+                 << c.dof << "," << c.shortest << "," << r.solver << "," << to_string(r.res.status) << ","
+                 << r.res.iterations << "," << r.res.evaluations << "," << r.res.factorizations << ","
+                 << r.res.timings.total << "," << budget << "," << std::setprecision(17) << r.res.energy << ","
+                 << best << "," << std::setprecision(6) << (r.res.energy - best) / scale << "," << r.res.grad_max
+                 << "," << tol << ",\"" << msg << "\"\n";
+            if (!wp) continue;
+            // Running minima, thinned to points where either dropped by >= 2% (plus the first and last).
+            double gmin = std::numeric_limits<double>::infinity(), emin = gmin, gl = gmin, el = gmin;
+            for (size_t i = 0; i < r.samples.size(); ++i) {
+                const auto& s = r.samples[i];
+                gmin = std::min(gmin, s.gmax);
+                emin = std::min(emin, (s.energy - best) / scale);
+                const bool last = i + 1 == r.samples.size();
+                if (i == 0 || last || gmin < 0.98 * gl || emin < 0.98 * el) {
+                    trace << case_id(c) << "," << c.scheme << "," << c.L << "," << c.a << "," << c.dof << ","
+                          << r.solver << "," << std::setprecision(6) << s.t << "," << s.evals << "," << gmin << ","
+                          << std::max(emin, 0.0) << "\n";
+                    gl = gmin, el = emin;
+                }
+            }
+        }
+        runs.flush();
+        trace.flush();
+    }
+    return 0;
+}

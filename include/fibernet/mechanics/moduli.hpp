@@ -1,0 +1,70 @@
+#pragma once
+// Linear (differential) moduli at an equilibrium from one Hessian factorization (DESIGN.md §2, docs/moduli.md).
+//
+// Along a strain path F(t) = F + t dF through an equilibrium q*:
+//   d2E/dt2 (relaxed) = E_tt - E_xt^T H^+ E_xt,    H = E_xx, E_xt = d2E/dx dt, E_tt = d2E/dt2 at fixed x,
+// and a modulus is scale * that. E_xt lies in range(H) at an equilibrium (differentiate g(q*(t), t) = 0), so
+// H's null space (translations, floppy clusters) does not contribute. H^+ E_xt is computed with ONE
+// factorization of H + delta I (delta = 1e-12 mean diag H, grown on failure), used as the preconditioner of
+// conjugate gradients on H u = E_xt: the preconditioned spectrum lambda / (lambda + delta) is 1 except for the few
+// modes with lambda ~ delta, so CG converges in a handful of steps, each one solve and no new factorization;
+// from u_0 = 0 it never enters the null space (the residual stays in range(H)). The last increments of
+// E_xt.u bound the remaining error (reported as `error`). The shift is not a bias: CG removes it.
+//
+// Normalisations (2D, current box area A):
+//   shear  G: dF = e_x e_y^T F (simple shear of the current state), G = (1/A) d2E/dt2;
+//   bulk   K: dF = F (isotropic dilation, dA/A = 2 dt), K = A d2E/dA2 = (1/(4A)) d2E/dt2  (K = lambda + mu in 2D);
+//   path    : dF = strain_direction(kind) of the scene's path, (1/A) d2E/dt2.
+// The affine prediction of each is scale * d2E/dt2 along the affine path x(t) = F(t) x_ref (no relaxation).
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "fibernet/box/box.hpp"
+#include "fibernet/energy/network_energy.hpp"
+
+namespace fibernet {
+
+struct StrainMode {
+    std::string name;
+    Eigen::Matrix2d dF = Eigen::Matrix2d::Zero();
+    double scale = 1;    // modulus = scale * relaxed d2E/dt2
+};
+StrainMode shear_mode(const Eigen::Matrix2d& F, double area);
+StrainMode bulk_mode(const Eigen::Matrix2d& F, double area);
+StrainMode path_mode(StrainKind k, double area);
+
+struct Modulus {
+    std::string name;
+    double value = 0;       // scale * (E_tt - E_xt^T H^+ E_xt)
+    double affine = 0;      // scale * E_tt of the affinely deformed reference (the affine prediction)
+    double E_tt = 0, correction = 0;  // unscaled affine (comoving) part and non-affine correction at the equilibrium
+    double error = 0;       // bound on |value error| from the refinement (scaled)
+    int refinements = 0;        // conjugate-gradient steps
+    Eigen::VectorXd response;   // a solution of H r = E_xt (absolute coordinates): dq/dt = -response along the mode
+    bool ok = false;        // false: H + delta I could not be factored or the refinement did not converge
+};
+
+struct ModuliOptions {
+    double delta_rel = 1e-12;   // initial shift relative to mean |diag H| (x100 while the factorization fails)
+    int max_refinements = 200;  // conjugate-gradient steps
+    double refine_tol = 1e-13;  // stop when a CG increment of E_xt.u is below this fraction of max(E_tt, b.M b)
+};
+
+struct ModuliInfo {
+    double delta = 0;          // shift of the factorization used
+    int factorizations = 0;
+    double seconds_assembly = 0, seconds_factorization = 0, seconds_solve = 0, seconds_affine = 0, seconds_total = 0;
+    double seconds_one_factorization = 0;   // the successful factorization alone, for the modulus/factorization ratio
+    std::string message;
+};
+
+// llt: an optional CHOLMOD wrapper already analyzed for e.hessian_pattern() (e.g. NewtonSolver::factorization()
+// after the equilibrium solve), so that the modulus costs one numeric factorization and no symbolic analysis.
+// Its numeric factor is overwritten.
+class CholmodLLT;
+std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
+                                   const std::vector<StrainMode>& modes, const ModuliOptions& opt = {},
+                                   ModuliInfo* info = nullptr, CholmodLLT* llt = nullptr);
+
+}  // namespace fibernet

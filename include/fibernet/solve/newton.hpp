@@ -1,0 +1,48 @@
+#pragma once
+// Newton's method with an exact sparse Hessian, CHOLMOD supernodal LL^T and Armijo backtracking (issue 3).
+//
+// The step ladder (docs/moduli.md, "Newton ladder"), tried in order at each iteration until a factorization
+// succeeds and the direction passes the descent check g.d < -1e-12 |g| |d|:
+//   0. exact H + mu I          mu = min(|g|_inf, mu_max) (regularized Newton: keeps quadratic convergence on
+//                              singular H — translations, floppy clusters — because mu -> 0 with |g|), floored at
+//                              mu_floor = 1e-13 * mean diag(H) (round-off scale of a null pivot);
+//   1. per-element PSD-projected H + mu I  (buckled or compressed segments make H indefinite);
+//   2. projected H + lambda I, lambda = 1e-8 * mean diag(H) * 10^j, j = 0..10;
+//   3. steepest descent d = -g.
+// The next iteration starts one rung above the one that worked (polysolve's up-and-down strategy).
+// Line search: Armijo backtracking from alpha = 1 (halving); +inf or NaN energies are failed trials (softcore,
+// stretch.hpp). Near convergence the energy decrease falls below round-off; a full step is then accepted when
+// the energy did not rise beyond round-off and max|g| fell.
+#include <memory>
+#include <vector>
+
+#include "fibernet/solve/cholmod_llt.hpp"
+#include "fibernet/solve/solver.hpp"
+
+namespace fibernet {
+
+class NewtonSolver : public Solver {
+public:
+    explicit NewtonSolver(SolverOptions opt) : opt_(opt) {}
+    std::string name() const override { return "newton"; }
+    SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
+
+    // max|g| after each iteration of the last minimize() (index 0: the start), for convergence-rate checks.
+    const std::vector<double>& history() const { return history_; }
+    // The rung of the ladder each iteration used (0..3).
+    const std::vector<int>& rungs() const { return rungs_; }
+    // The CHOLMOD wrapper of the last minimize(), symbolically analyzed for that objective's Hessian pattern (kept
+    // across calls: a strain sweep or the modulus after an equilibrium reuses the analysis); null before any call.
+    CholmodLLT* factorization() { return llt_.get(); }
+    // The wrapper analyzed for `pattern` (analyzing it only if the pattern changed); minimize() uses the same.
+    CholmodLLT& factorization_for(const Eigen::SparseMatrix<double>& pattern, double* seconds = nullptr);
+
+private:
+    SolverOptions opt_;
+    std::vector<double> history_;
+    std::vector<int> rungs_;
+    std::unique_ptr<CholmodLLT> llt_;
+    Eigen::SparseMatrix<double> analyzed_;  // the pattern llt_ was analyzed for
+};
+
+}  // namespace fibernet

@@ -1,0 +1,68 @@
+#pragma once
+// Relaxation under capillary load with mobile bridges (issue 6, part 2): an outer active-set loop around a
+// minimizer. The energy is smooth while the set of bridged segment pairs is fixed (WetEnergy); between solves the
+// set is updated from the relaxed geometry:
+//   move     a crossing left its home segment: the bridge moves to the neighbouring segment (no energy change, see
+//            bridge.hpp), repeatedly, until its crossing is inside its home pair;
+//   rupture  a crossing slid past a fiber end far enough that the bridge's weight is zero (no energy change);
+//   form     two segments of different fibers intersect with no bridge on or next to that pair (fibers zipping):
+//            a new bridge (new crossings are always wet);
+//   merge    two bridges landed on the same pair: one is dropped;
+//   lock     a bridge whose crossing sits inside its home pair (weight 1) and whose pair is aligned within
+//            contact_angle becomes a bundle bridge (bridge.hpp; no energy change, not counted as a change);
+//   zip      two nearly aligned segments of different fibers in contact (distance <= contact_distance, overlapping
+//            by at least half the shorter one) with no bridge on either segment towards the other fiber: a new locked
+//            bridge (counted as formed). A locked bridge ruptures when its pair is no longer in contact (hysteresis:
+//            twice the angle and the distance).
+// The loop stops when q is an equilibrium of the updated set (stable: its gradient is no larger than the one the solver
+// accepted, so moves and locks, which leave the energy unchanged, need no new solve), when a bridge set repeats an
+// earlier round's (cycling, reported, the last state kept), when the solver fails, or after max_rounds. A solve that
+// hits its iteration limit is not a failure: the set is updated and the next round continues from there.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "fibernet/solve/solver.hpp"
+#include "fibernet/wet/wet_energy.hpp"
+
+namespace fibernet {
+
+struct WetEvents {
+    int moves = 0, ruptures = 0, formed = 0, merged = 0, locked = 0;
+    int total() const { return moves + ruptures + formed + merged; }
+};
+
+struct ActiveSetOptions {
+    int max_rounds = 30;
+    bool form_new = true;        // give new crossings and new contacts bridges
+    double contact_distance = 0;  // seed units; 0: the fiber diameter 2 r = 2 ls / a
+    double contact_angle_deg = 10;
+};
+
+struct ActiveSetResult {
+    std::vector<Bridge> bridges;   // the final set
+    SolveResult last;              // the last solve (its status says whether q is an equilibrium of the final set)
+    WetEvents events;              // summed over rounds
+    std::vector<WetEvents> per_round;
+    int rounds = 0, solver_iterations = 0;
+    bool stable = false;           // the last round changed nothing: q is an equilibrium with a consistent set
+    bool cycling = false;          // a bridge set repeated
+    std::string message;
+    double seconds_solve = 0, seconds_events = 0;
+};
+
+// Updates `bridges` (moves, ruptures, merges; new bridges if form_new) at state q of `dry` at F; returns the counts.
+WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
+                         std::vector<Bridge>& bridges, const ActiveSetOptions& opt = {});
+
+// All intersecting segment pairs of different fibers that share no node, as bridges (nearest periodic image).
+std::vector<Bridge> segment_crossings(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B);
+// All segment pairs of different fibers in contact (see "zip" above), as locked bridges.
+std::vector<Bridge> segment_contacts(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double distance,
+                                     double angle_deg);
+
+ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, const WetParams& params,
+                          std::vector<Bridge> bridges, Solver& solver, Eigen::VectorXd& q,
+                          const ActiveSetOptions& opt = {});
+
+}  // namespace fibernet

@@ -1,0 +1,64 @@
+#pragma once
+// The wet network's energy at a fixed box deformation F, as a solver sees it (issue 6, part 1):
+//   E(q) = dry stretching + bending (NetworkEnergy, unchanged) + sum over bridges of the blended capillary element
+// (bridge.hpp). The bridge set is fixed for the lifetime of a WetEnergy: the Hessian pattern (the dry pattern united
+// with each bridge's 8-node block) is built once here, and the active-set loop (active_set.hpp) makes a new WetEnergy
+// when the set changes. With beta = 0 no bridge term is evaluated and the pattern is the dry one, so every value,
+// gradient and Hessian (and hence every solve) is bit for bit the dry one.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "fibernet/energy/capillary.hpp"
+#include "fibernet/energy/network_energy.hpp"
+#include "fibernet/energy/objective.hpp"
+#include "fibernet/wet/bridge.hpp"
+
+namespace fibernet {
+
+struct WetParams {
+    double beta = 0;    // adhesion energy per unit length of a two-fiber bundle (bending-energy units per seed unit)
+    CapillaryLaw law;   // phi(cos^2 alpha); default -c
+};
+
+struct WetSplit {
+    double stretch = 0, bend = 0, capillary = 0;
+    double total() const { return stretch + bend + capillary; }
+};
+
+class WetEnergy : public Objective {
+public:
+    WetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, std::vector<Bridge> bridges, WetParams params);
+
+    int size() const override { return dry_.num_dofs(); }
+    double value(const Eigen::VectorXd& q) override;
+    double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override;
+    double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool project_psd) override;
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
+
+    WetSplit split(const Eigen::VectorXd& q) const;
+    // Each bridge's own energy at q (for reports and the continuity test).
+    std::vector<double> bridge_energies(const Eigen::VectorXd& q) const;
+
+    const NetworkEnergy& dry() const { return dry_; }
+    const Eigen::Matrix2d& F() const { return F_; }
+    const std::vector<Bridge>& bridges() const { return bridges_; }
+    const std::vector<BridgeElement>& elements() const { return elements_; }
+    const WetParams& params() const { return params_; }
+
+private:
+    double eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd);
+    bool active() const { return params_.beta != 0 && !bridges_.empty(); }
+
+    const NetworkEnergy& dry_;
+    Eigen::Matrix2d F_;
+    std::vector<Bridge> bridges_;
+    std::vector<BridgeElement> elements_;
+    WetParams params_;
+    Eigen::SparseMatrix<double> pattern_, dry_H_;
+    std::vector<int> dry_slot_;     // dry pattern value index -> union value index
+    std::vector<int> bridge_slots_; // 256 per bridge: union value index of local (a, b) with row <= col, else -1
+    EnergyEval eval_;
+};
+
+}  // namespace fibernet

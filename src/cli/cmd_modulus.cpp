@@ -1,0 +1,122 @@
+// fibernet modulus: equilibrium at the scene's strain, then the linear shear and bulk moduli from one
+// factorization (docs/moduli.md), normalised by the affine prediction. Exit 1 (JSON with status, moduli null)
+// when the equilibrium or the modulus solve did not converge.
+#include <chrono>
+
+#include "common.hpp"
+#include "fibernet/mechanics/equilibrium.hpp"
+#include "fibernet/mechanics/moduli.hpp"
+#include "fibernet/mechanics/stress.hpp"
+#include "fibernet/solve/newton.hpp"
+#include "fibernet/solve/solver.hpp"
+
+namespace fibernet::cli {
+
+nlohmann::json solve_json(const SolveResult& r, double tol) {
+    return {{"name", r.solver},
+            {"status", to_string(r.status)},
+            {"message", r.message},
+            {"iterations", r.iterations},
+            {"factorizations", r.factorizations},
+            {"evaluations", r.evaluations},
+            {"grad_max", r.grad_max},
+            {"grad_floor_bound", r.grad_floor},
+            {"tol", tol},
+            {"seconds",
+             {{"assembly", r.timings.assembly},
+              {"factorization", r.timings.factorization},
+              {"solve", r.timings.solve},
+              {"line_search", r.timings.line_search},
+              {"total", r.timings.total}}}};
+}
+
+nlohmann::json stress_json(const Stress& s) {
+    return {{"xx", s.sigma(0, 0)}, {"xy", s.sigma(0, 1)}, {"yx", s.sigma(1, 0)}, {"yy", s.sigma(1, 1)},
+            {"area", s.area}};
+}
+
+namespace {
+nlohmann::json number_or_null(double v, bool ok) { return ok && std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+}  // namespace
+
+void register_modulus(CLI::App& app) {
+    auto* cmd = app.add_subcommand("modulus", "equilibrium and linear shear/bulk moduli of a network (JSON)");
+    auto flags = std::make_shared<SceneFlags>();
+    flags->add(cmd, true);
+    auto verbose = std::make_shared<bool>(false);
+    auto start = std::make_shared<std::string>("affine");
+    cmd->add_option("--start", *start, "start of a strained solve: affine (default) | linear (affine + linear response)")
+        ->check(CLI::IsMember({"affine", "linear"}));
+    cmd->add_flag("-v,--verbose", *verbose, "solver progress on stderr");
+    cmd->callback([flags, verbose, start] {
+        const auto t_all = std::chrono::steady_clock::now();
+        Scene s = flags->resolve();
+        SolverOptions so;
+        so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.verbose = *verbose;
+        auto solver = make_solver(s.solver.name, so);  // unknown name: InputError before any work
+
+        auto t0 = std::chrono::steady_clock::now();
+        Network net = scene_network(s);
+        const double t_net = seconds_since(t0);
+        t0 = std::chrono::steady_clock::now();
+        Model m = discretize(net, s.discretization);
+        NetworkEnergy e(m);
+        const double t_model = seconds_since(t0);
+
+        const Eigen::Matrix2d F = deformation(s.strain, s.gamma);
+        Equilibrium eq = relax(e, F, *solver, nullptr, Eigen::Matrix2d::Identity(), *start == "linear");
+        const bool conv = eq.converged();
+
+        nlohmann::json moduli = nullptr, stress_j = nullptr, lin = nullptr;
+        bool ok = conv;
+        if (conv) {
+            const Stress st = stress(e, eq.q, F);
+            stress_j = stress_json(st);
+            std::vector<StrainMode> modes = {shear_mode(F, st.area), bulk_mode(F, st.area)};
+            if (s.strain != StrainKind::Shear) modes.push_back(path_mode(s.strain, st.area));
+            ModuliInfo info;
+            auto* newton = dynamic_cast<NewtonSolver*>(solver.get());  // reuse its symbolic analysis
+            const auto mods = linear_moduli(e, eq.q, F, modes, {}, &info, newton ? newton->factorization() : nullptr);
+            moduli = nlohmann::json::object();
+            for (const auto& M : mods) {
+                ok = ok && M.ok;
+                moduli[M.name] = number_or_null(M.value, M.ok);
+                moduli[M.name + "_affine"] = M.affine;
+                moduli[M.name + "_ratio"] = number_or_null(M.affine != 0 ? M.value / M.affine : NAN, M.ok);
+                moduli[M.name + "_error"] = number_or_null(M.error, M.ok);
+                moduli[M.name + "_refinements"] = M.refinements;
+            }
+            lin = {{"shift", info.delta},
+                   {"factorizations", info.factorizations},
+                   {"message", info.message},
+                   {"seconds",
+                    {{"assembly", info.seconds_assembly},
+                     {"factorization", info.seconds_factorization},
+                     {"one_factorization", info.seconds_one_factorization},
+                     {"solve", info.seconds_solve},
+                     {"affine", info.seconds_affine},
+                     {"total", info.seconds_total}}}};
+        }
+        emit_json({{"scene", s.source},
+                   {"status", ok ? "converged" : (conv ? "modulus_failed" : to_string(eq.result.status))},
+                   {"strain", to_string(s.strain)},
+                   {"gamma", s.gamma},
+                   {"units", "seed units: length ls = lf/10, energy = bending energy of unit length at unit curvature; "
+                             "moduli and stress in energy per area"},
+                   {"moduli", moduli},
+                   {"stress", stress_j},
+                   {"energy", {{"total", eq.energy}, {"stretch", eq.stretch}, {"bend", eq.bend}}},
+                   {"network", to_json(statistics(net))},
+                   {"model", to_json(summarize(m))},
+                   {"scheme", to_string(s.discretization.scheme)},
+                   {"solver", solve_json(eq.result, s.solver.tol)},
+                   {"start", eq.start},
+                   {"linear_solve", lin},
+                   {"seconds",
+                    {{"network", t_net}, {"model", t_model}, {"equilibrium", eq.result.timings.total},
+                     {"total", seconds_since(t_all)}}}});
+        if (!ok) exit_code() = 1;
+    });
+}
+
+}  // namespace fibernet::cli

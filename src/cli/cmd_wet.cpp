@@ -1,0 +1,181 @@
+// fibernet wet: dry network -> relax -> wet -> relax under capillary load (issue 6). JSON summary on stdout; with
+// -o DIR also summary.json, sweep.csv, pores.csv, network.svg (dry | wet) and pores.svg (pore-size distributions).
+// Exit 1 when a relaxation did not reach a stable equilibrium (results still reported, marked).
+#include <cmath>
+#include <sstream>
+
+#include "common.hpp"
+#include "fibernet/energy/capillary.hpp"
+#include "fibernet/network/network_io.hpp"
+#include "fibernet/util/error.hpp"
+#include "fibernet/wet/wet_run.hpp"
+#include "fibernet/wet/wet_svg.hpp"
+
+namespace fibernet::cli {
+
+nlohmann::json solve_json(const SolveResult& r, double tol);  // cmd_modulus.cpp
+
+namespace {
+nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
+nlohmann::json pore_json(const PoreStats& p) {
+    double sum = 0, dsum = 0, amax = 0;
+    for (const auto& q : p.pores) sum += q.area, dsum += q.diameter, amax = std::max(amax, q.area);
+    const double n = static_cast<double>(p.pores.size());
+    return {{"count", p.pores.size()}, {"mean_area", n ? num(sum / n) : nlohmann::json()},
+            {"mean_diameter", n ? num(dsum / n) : nlohmann::json()}, {"largest_area", amax},
+            {"remainder_area", p.remainder}, {"box_area", p.box_area}, {"open_cycles", p.open_cycles}};
+}
+
+nlohmann::json energy_json(const WetSplit& e) {
+    return {{"total", e.total()}, {"stretch", e.stretch}, {"bend", e.bend}, {"capillary", e.capillary}};
+}
+}  // namespace
+
+void register_wet(CLI::App& app) {
+    auto* cmd = app.add_subcommand("wet", "wet a network: capillary bridges, bundles, pores, moduli dry and wet");
+    auto flags = std::make_shared<SceneFlags>();
+    flags->add(cmd, true);
+    struct WetFlags {
+        double beta = 0, fraction = 0;
+        std::vector<double> betas;
+        std::string law, crossings, out;
+        std::uint64_t seed = 0;
+        bool no_moduli = false, verbose = false;
+    };
+    auto w = std::make_shared<WetFlags>();
+    auto* o_beta = cmd->add_option("--beta", w->beta, "adhesion per unit bundle length, bending units (default 1)");
+    cmd->add_option("--betas", w->betas, "a beta sweep, e.g. --betas 0,0.1,0.3,1 (overrides --beta)")->delimiter(',');
+    auto* o_law = cmd->add_option("--law", w->law, "tabulated capillary law file: lines 'alpha_deg value'");
+    auto* o_cr = cmd->add_option("--crossings", w->crossings, "wet crossings: all | free | fraction (default all)");
+    auto* o_fr = cmd->add_option("--fraction", w->fraction, "wet fraction of crossings, in [0, 1]");
+    auto* o_ws = cmd->add_option("--wet-seed", w->seed, "seed of the wet fraction draw");
+    cmd->add_option("-o,--out-dir", w->out, "write summary.json, sweep.csv, pores.csv, network.svg, pores.svg here");
+    cmd->add_flag("--no-moduli", w->no_moduli, "skip the dry and wet shear moduli");
+    cmd->add_flag("-v,--verbose", w->verbose, "solver progress on stderr");
+    cmd->callback([=] {
+        const auto t_all = std::chrono::steady_clock::now();
+        Scene s = flags->resolve();
+        if (flags->scene_file.empty() && !flags->given("--pl")) s.mikado.pl = 0.5;  // the thesis's wet networks
+        if (o_beta->count()) s.wet.beta = w->beta;
+        if (o_law->count()) s.wet.law = w->law;
+        if (o_cr->count()) s.wet.crossings = w->crossings;
+        if (o_fr->count()) s.wet.fraction = w->fraction;
+        if (o_ws->count()) s.wet.seed = w->seed;
+        s.source = flags->scene_file.empty() ? "command line" : flags->scene_file + " + command line";
+        s.check();
+        std::vector<double> betas = w->betas.empty() ? std::vector<double>{s.wet.beta} : w->betas;
+        for (double b : betas) check_value(b >= 0, b, "--betas", "beta", "must be >= 0");
+
+        WetRunOptions opt;
+        if (!s.wet.law.empty()) opt.params.law = CapillaryLaw::read(s.wet.law);
+        opt.rule.which = parse_wet_which(s.wet.crossings);
+        opt.rule.fraction = s.wet.fraction, opt.rule.seed = s.wet.seed;
+        opt.solver = s.solver.name;
+        opt.solver_options.tol = s.solver.tol, opt.solver_options.max_iter = s.solver.max_iter;
+        opt.solver_options.verbose = w->verbose;
+        opt.moduli = !w->no_moduli;
+        make_solver(opt.solver, opt.solver_options);  // an unknown solver is an InputError before any work
+
+        const Network net = scene_network(s);
+        const Model m = discretize(net, s.discretization);
+        const Eigen::Matrix2d F = deformation(s.strain, s.gamma);
+        const Eigen::Matrix2d B = F * m.box.B0();
+
+        nlohmann::json runs = nlohmann::json::array();
+        std::ostringstream sweep, pore_csv;
+        sweep << "beta,status,bridges,moves,ruptures,formed,merged,rounds,E_stretch,E_bend,E_capillary,pores,mean_pore_area,"
+                 "mean_pore_diameter,bundled_fibers,largest_bundle,G_dry,G_wet\n";
+        pore_csv << "state,beta,area,diameter\n";
+        sweep.precision(10), pore_csv.precision(10);
+        bool ok = true, dry_written = false;
+        WetState dry_state;
+        std::vector<SvgPanel> panels;
+        std::vector<std::string> hist_names;
+        std::vector<std::vector<double>> hist_values;
+        for (size_t k = 0; k < betas.size(); ++k) {
+            opt.params.beta = betas[k];
+            const WetRun r = run_wet(net, m, F, opt, k == 0 ? nullptr : &dry_state);
+            if (k == 0) dry_state = r.dry;
+            const bool good = r.dry.converged && r.wet.converged && r.active.stable;
+            ok = ok && good;
+            const auto& pw = r.wet.pores.pores;
+            double sum = 0, dsum = 0;
+            for (const auto& p : pw) sum += p.area, dsum += p.diameter;
+            const int largest = r.bundles.sizes.empty() ? 1 : r.bundles.sizes.front();
+            sweep << betas[k] << "," << (good ? "ok" : "not_stable") << "," << r.active.bridges.size() << ","
+                  << r.active.events.moves << "," << r.active.events.ruptures << "," << r.active.events.formed << ","
+                  << r.active.events.merged << "," << r.active.rounds << "," << r.wet.energy.stretch << ","
+                  << r.wet.energy.bend << "," << r.wet.energy.capillary << "," << pw.size() << ","
+                  << (pw.empty() ? 0 : sum / pw.size()) << "," << (pw.empty() ? 0 : dsum / pw.size()) << ","
+                  << r.bundles.bundled_fibers << "," << largest << "," << dry_state.shear_modulus << ","
+                  << r.wet.shear_modulus << "\n";
+            if (!dry_written) {
+                for (const auto& p : r.dry.pores.pores) pore_csv << "dry,0," << p.area << "," << p.diameter << "\n";
+                std::vector<double> d;
+                for (const auto& p : r.dry.pores.pores) d.push_back(p.diameter);
+                hist_names.push_back("dry"), hist_values.push_back(d);
+                NetworkEnergy e(m);
+                panels.push_back({"dry", e.positions(r.dry.q, F), B, {}, {}, {}});
+                dry_written = true;
+            }
+            for (const auto& p : pw) pore_csv << "wet," << betas[k] << "," << p.area << "," << p.diameter << "\n";
+            std::vector<double> d;
+            for (const auto& p : pw) d.push_back(p.diameter);
+            std::ostringstream name;
+            name << "wet, beta = " << betas[k];
+            hist_names.push_back(name.str()), hist_values.push_back(d);
+            if (k + 1 == betas.size()) {
+                NetworkEnergy e(m);
+                std::vector<int> size(m.chains.size(), 0);
+                for (int lab : r.bundles.bundle_of_fiber) ++size[lab];
+                panels.push_back({name.str() + " (bridges red, bundles coloured)", e.positions(r.wet.q, F), B,
+                                  r.active.bridges, r.bundles.bundle_of_fiber, size});
+            }
+            nlohmann::json hist = nlohmann::json::object();
+            for (const auto& [size, count] : r.bundles.histogram) hist[std::to_string(size)] = count;
+            runs.push_back(
+                {{"beta", betas[k]},
+                 {"status", good ? "stable" : "not_stable"},
+                 {"message", r.active.message},
+                 {"energy", {{"dry", energy_json(r.dry.energy)}, {"wet", energy_json(r.wet.energy)}}},
+                 {"bridges", {{"initial", r.initial_bridges.size()}, {"final", r.active.bridges.size()}}},
+                 {"events",
+                  {{"moves", r.active.events.moves}, {"ruptures", r.active.events.ruptures},
+                   {"formed", r.active.events.formed}, {"merged", r.active.events.merged},
+                   {"locked", r.active.events.locked}, {"rounds", r.active.rounds}, {"cycling", r.active.cycling}}},
+                 {"bundles",
+                  {{"bundled_fibers", r.bundles.bundled_fibers}, {"count", r.bundles.sizes.size()},
+                   {"largest", largest}, {"size_histogram", hist}, {"aligned_bridges", r.bundles.aligned_bridges}}},
+                 {"pores", {{"dry", pore_json(r.dry.pores)}, {"wet", pore_json(r.wet.pores)}}},
+                 {"shear_modulus", {{"dry", num(dry_state.shear_modulus)}, {"wet", num(r.wet.shear_modulus)}}},
+                 {"solver", solve_json(r.active.last, s.solver.tol)},
+                 {"solver_iterations", r.active.solver_iterations},
+                 {"seconds",
+                  {{"dry", r.seconds_dry}, {"wet_solve", r.seconds_wet_solve}, {"events", r.seconds_events},
+                   {"pores", r.seconds_pores}, {"moduli", r.seconds_moduli}}}});
+        }
+        nlohmann::json j = {{"scene", s.source},
+                            {"network", to_json(statistics(net))},
+                            {"model", to_json(summarize(m))},
+                            {"wet",
+                             {{"law", s.wet.law.empty() ? "cos2" : s.wet.law},
+                              {"crossings", s.wet.crossings},
+                              {"fraction", s.wet.fraction}}},
+                            {"gamma", s.gamma},
+                            {"runs", runs},
+                            {"seconds", seconds_since(t_all)}};
+        if (!w->out.empty()) {
+            const std::string d = w->out + "/";
+            write_file_atomic(d + "sweep.csv", sweep.str());
+            write_file_atomic(d + "pores.csv", pore_csv.str());
+            write_file_atomic(d + "network.svg", network_svg(m, panels));
+            write_file_atomic(d + "pores.svg", histogram_svg(hist_names, hist_values, "pore equivalent diameter (seed units)"));
+            emit_json(j, d + "summary.json");
+        }
+        emit_json(j);
+        if (!ok) exit_code() = 1;
+    });
+}
+
+}  // namespace fibernet::cli

@@ -1,0 +1,329 @@
+#include "fibernet/wet/active_set.hpp"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "fibernet/wet/wetting.hpp"
+
+namespace fibernet {
+
+namespace {
+double now() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Moves side s of b one segment in direction dir (+1 / -1), keeping fiber 2's image consistent with the frame,
+// which is anchored at fiber 1's home start node (bridge.hpp).
+void move(const Model& m, Bridge& b, int s, int dir) {
+    const FiberChain& ch = m.chains[s == 0 ? b.f1 : b.f2];
+    int& k = s == 0 ? b.k1 : b.k2;
+    const Eigen::Vector2i sh = m.segments[ch.segments[dir > 0 ? k : k - 1]].shift;
+    // Side 0 re-anchors the frame at its new start node; side 1 carries its own image along its chain.
+    if (s == 0) b.image += dir > 0 ? Eigen::Vector2i(-sh) : sh;
+    else b.image += dir > 0 ? sh : Eigen::Vector2i(-sh);
+    k += dir;
+}
+
+using Key = std::array<int, 6>;  // a segment pair
+Key key(const Bridge& b) { return {b.f1, b.f2, b.k1, b.k2, b.image.x(), b.image.y()}; }
+std::array<int, 7> full_key(const Bridge& b) { return {b.f1, b.f2, b.k1, b.k2, b.image.x(), b.image.y(), b.locked}; }
+}  // namespace
+
+namespace {
+struct SegGeom {
+    std::vector<int> fiber, pos;
+    std::vector<Eigen::Vector2d> P, D;
+};
+
+SegGeom seg_geom(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B) {
+    const int ns = static_cast<int>(m.segments.size());
+    SegGeom g;
+    g.fiber.resize(ns), g.pos.resize(ns), g.P.resize(ns), g.D.resize(ns);
+    for (size_t f = 0; f < m.chains.size(); ++f)
+        for (size_t k = 0; k < m.chains[f].segments.size(); ++k)
+            g.fiber[m.chains[f].segments[k]] = static_cast<int>(f), g.pos[m.chains[f].segments[k]] = static_cast<int>(k);
+    for (int e = 0; e < ns; ++e) {
+        const Segment& s = m.segments[e];
+        g.P[e] = x.segment<2>(2 * s.i);
+        g.D[e] = x.segment<2>(2 * s.j) - g.P[e] + B * s.shift.cast<double>();
+    }
+    return g;
+}
+
+// Calls visit(a, b, Pb) for every pair of segments of different fibers sharing no node whose midpoints are within
+// (la + lb) / 2 + extra, with Pb the start of b at its image nearest to a. Cell list in reduced coordinates.
+template <class Visit>
+void near_pairs(const Model& m, const SegGeom& g, const Eigen::Matrix2d& B, double extra, Visit visit) {
+    const int ns = static_cast<int>(m.segments.size());
+    const Eigen::Matrix2d Bi = B.inverse();
+    std::vector<Eigen::Vector2d> U(ns);
+    double lmax = 0;
+    for (int e = 0; e < ns; ++e) {
+        lmax = std::max(lmax, g.D[e].norm());
+        U[e] = Bi * (g.P[e] + 0.5 * g.D[e]);
+        if (m.box.periodic) U[e] = U[e].array() - U[e].array().floor();
+    }
+    Eigen::JacobiSVD<Eigen::Matrix2d> svd(Bi);
+    const double reach = svd.singularValues()(0) * (lmax + extra);
+    Eigen::Vector2d lo(0, 0), hi(1, 1);
+    if (!m.box.periodic && ns > 0) {
+        lo = hi = U[0];
+        for (const auto& u : U) lo = lo.cwiseMin(u), hi = hi.cwiseMax(u);
+    }
+    const Eigen::Vector2d span = (hi - lo).cwiseMax(1e-300);
+    int nc[2];
+    for (int c = 0; c < 2; ++c)
+        nc[c] = std::max(1, std::min(4096, static_cast<int>(std::floor(span[c] / std::max(reach, 1e-300)))));
+    if (m.box.periodic && (nc[0] < 3 || nc[1] < 3)) nc[0] = nc[1] = 1;  // small box: all pairs
+    std::vector<std::vector<int>> cell(static_cast<size_t>(nc[0]) * nc[1]);
+    auto cell_of = [&](const Eigen::Vector2d& u, int c) {
+        return std::min(nc[c] - 1, std::max(0, static_cast<int>((u[c] - lo[c]) / span[c] * nc[c])));
+    };
+    for (int e = 0; e < ns; ++e) cell[cell_of(U[e], 0) + nc[0] * cell_of(U[e], 1)].push_back(e);
+    auto test = [&](int a, int b) {
+        if (g.fiber[a] == g.fiber[b]) return;
+        const Segment &sa = m.segments[a], &sb = m.segments[b];
+        if (sa.i == sb.i || sa.i == sb.j || sa.j == sb.i || sa.j == sb.j) return;  // meet at a shared node
+        Eigen::Vector2d Pb = g.P[b];
+        if (m.box.periodic) {
+            const Eigen::Vector2d w = Bi * (g.P[b] + 0.5 * g.D[b] - g.P[a] - 0.5 * g.D[a]);
+            Pb -= B * w.array().round().matrix();
+        }
+        visit(a, b, Pb);
+    };
+    const bool all = nc[0] == 1 && nc[1] == 1;
+    for (int cy = 0; cy < nc[1]; ++cy)
+        for (int cx = 0; cx < nc[0]; ++cx)
+            for (int a : cell[cx + nc[0] * cy]) {
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        if (all && (dx || dy)) continue;
+                        int X = cx + dx, Y = cy + dy;
+                        if (m.box.periodic) X = (X + nc[0]) % nc[0], Y = (Y + nc[1]) % nc[1];
+                        else if (X < 0 || Y < 0 || X >= nc[0] || Y >= nc[1]) continue;
+                        for (int b : cell[X + nc[0] * Y])
+                            if (b > a) test(a, b);
+                    }
+            }
+}
+
+bool intersects(const Eigen::Vector2d& Pa, const Eigen::Vector2d& Da, const Eigen::Vector2d& Pb, const Eigen::Vector2d& Db) {
+    const double den = cross2(Da, Db);
+    if (den == 0) return false;
+    const double t = cross2(Pb - Pa, Db) / den, u = cross2(Pb - Pa, Da) / den;
+    return t >= 0 && t < 1 && u >= 0 && u < 1;
+}
+
+double point_segment(const Eigen::Vector2d& p, const Eigen::Vector2d& P, const Eigen::Vector2d& D) {
+    const double t = std::min(1.0, std::max(0.0, (p - P).dot(D) / D.squaredNorm()));
+    return (P + t * D - p).norm();
+}
+
+struct Contact {
+    double sin_angle, distance, overlap;  // overlap: length of b's projection onto a inside a
+};
+Contact contact(const Eigen::Vector2d& Pa, const Eigen::Vector2d& Da, const Eigen::Vector2d& Pb, const Eigen::Vector2d& Db) {
+    Contact c;
+    c.sin_angle = std::abs(cross2(Da, Db)) / (Da.norm() * Db.norm());
+    c.distance = intersects(Pa, Da, Pb, Db) ? 0.0
+                 : std::min({point_segment(Pa, Pb, Db), point_segment(Pa + Da, Pb, Db), point_segment(Pb, Pa, Da),
+                             point_segment(Pb + Db, Pa, Da)});
+    const double la = Da.norm();
+    const Eigen::Vector2d u = Da / la;
+    const double t0 = (Pb - Pa).dot(u), t1 = (Pb + Db - Pa).dot(u);
+    c.overlap = std::max(0.0, std::min(la, std::max(t0, t1)) - std::max(0.0, std::min(t0, t1)));
+    return c;
+}
+}  // namespace
+
+std::vector<Bridge> segment_crossings(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B) {
+    const SegGeom g = seg_geom(m, x, B);
+    std::vector<Bridge> out;
+    near_pairs(m, g, B, 0.0, [&](int a, int b, const Eigen::Vector2d& Pb) {
+        if (intersects(g.P[a], g.D[a], Pb, g.D[b]))
+            out.push_back(make_bridge(m, x, B, g.fiber[a], g.pos[a], g.fiber[b], g.pos[b]));
+    });
+    return out;
+}
+
+std::vector<Bridge> segment_contacts(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double distance,
+                                     double angle_deg) {
+    const SegGeom g = seg_geom(m, x, B);
+    const double smax = std::sin(angle_deg * M_PI / 180);
+    std::vector<Bridge> out;
+    near_pairs(m, g, B, distance, [&](int a, int b, const Eigen::Vector2d& Pb) {
+        const Contact c = contact(g.P[a], g.D[a], Pb, g.D[b]);
+        const double lmin = std::min(g.D[a].norm(), g.D[b].norm());
+        if (c.sin_angle <= smax && c.distance <= distance && c.overlap >= 0.5 * lmin) {
+            Bridge br = make_bridge(m, x, B, g.fiber[a], g.pos[a], g.fiber[b], g.pos[b]);
+            br.locked = true;
+            out.push_back(br);
+        }
+    });
+    return out;
+}
+
+WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
+                         std::vector<Bridge>& bridges, const ActiveSetOptions& opt) {
+    const Model& m = dry.model();
+    const Eigen::VectorXd x = dry.positions(q, F);
+    const Eigen::Matrix2d B = F * m.box.B0();
+    const double rc = opt.contact_distance > 0 ? opt.contact_distance : 2.0 / m.aspect_ratio;
+    const double sin_c = std::sin(opt.contact_angle_deg * M_PI / 180);
+    // The home pair's segment vectors in the bridge frame.
+    auto pair_contact = [&](const Bridge& b) {
+        const BridgeElement el = resolve(m, b);
+        const Vector16d X = element_coordinates(el, x, B);
+        return contact(X.segment<2>(2), X.segment<2>(4) - X.segment<2>(2), X.segment<2>(10), X.segment<2>(12) - X.segment<2>(10));
+    };
+    WetEvents ev;
+    std::vector<Bridge> kept;
+    kept.reserve(bridges.size());
+    for (Bridge b : bridges) {
+        bool alive = true;
+        if (b.locked) {
+            const Contact c = pair_contact(b);
+            alive = c.sin_angle <= std::min(1.0, 2 * sin_c) && c.distance <= 2 * rc && c.overlap > 0;
+            if (alive) kept.push_back(b);
+            else ++ev.ruptures;
+            continue;
+        }
+        const int limit = 4 + 2 * static_cast<int>(m.chains[b.f1].segments.size() + m.chains[b.f2].segments.size());
+        CrossingPosition cp;
+        for (int it = 0; it < limit && alive; ++it) {
+            const BridgeElement el = resolve(m, b);
+            cp = crossing_position(el, element_coordinates(el, x, B));
+            if (!cp.defined) break;
+            bool moved = false;
+            for (int s = 0; s < 2 && !moved && alive; ++s) {
+                const int k = s == 0 ? b.k1 : b.k2;
+                const int nseg = static_cast<int>(m.chains[s == 0 ? b.f1 : b.f2].segments.size());
+                if (cp.z[s][0] < 0) {
+                    if (k > 0) move(m, b, s, -1), moved = true;
+                    else if (cp.z[s][0] <= -cp.delta[s][0]) alive = false;  // off the fiber's start, weight zero
+                } else if (cp.z[s][1] > 0) {
+                    if (k + 1 < nseg) move(m, b, s, +1), moved = true;
+                    else if (cp.z[s][1] >= cp.delta[s][1]) alive = false;  // off the fiber's end
+                }
+            }
+            if (!moved) break;
+            ++ev.moves;
+        }
+        if (!alive) {
+            ++ev.ruptures;
+            continue;
+        }
+        // Lock an aligned bridge whose weight sits wholly on its home pair (no energy change). A nearly parallel pair
+        // (crossing undefined, home-only weights) is locked if in contact, and ruptures once the fibers separate.
+        const Contact c = pair_contact(b);
+        const bool home_only = !cp.defined || (cp.z[0][0] >= cp.delta[0][0] && cp.z[0][1] <= -cp.delta[0][1] &&
+                                               cp.z[1][0] >= cp.delta[1][0] && cp.z[1][1] <= -cp.delta[1][1]);
+        if (home_only && c.sin_angle <= sin_c && c.distance <= rc && c.overlap > 0) {
+            b.locked = true, ++ev.locked;
+        } else if (!cp.defined && (c.distance > 2 * rc || c.overlap == 0)) {
+            ++ev.ruptures;
+            continue;
+        }
+        kept.push_back(b);
+    }
+    // Two bridges on one pair: keep the first.
+    std::set<Key> seen;
+    bridges.clear();
+    for (const Bridge& b : kept) {
+        if (seen.insert(key(b)).second) bridges.push_back(b);
+        else ++ev.merged;
+    }
+    if (!opt.form_new) return ev;
+    // Existing bridges by fiber pair and image: a crossing on or next to a bridged pair is that bridge's (a crossing
+    // at a node is found on either side of it); a contact needs both its segments free towards the other fiber.
+    std::map<std::array<int, 4>, std::vector<std::pair<int, int>>> near;
+    std::set<std::array<int, 3>> partnered;  // (fiber, segment, other fiber) holding a bridge
+    auto note = [&](const Bridge& b) {
+        near[{b.f1, b.f2, b.image.x(), b.image.y()}].push_back({b.k1, b.k2});
+        partnered.insert({b.f1, b.k1, b.f2}), partnered.insert({b.f2, b.k2, b.f1});
+    };
+    for (const Bridge& b : bridges) note(b);
+    for (const Bridge& c : segment_crossings(m, x, B)) {
+        auto& v = near[{c.f1, c.f2, c.image.x(), c.image.y()}];
+        const bool known = std::any_of(v.begin(), v.end(), [&](const std::pair<int, int>& h) {
+            return std::abs(h.first - c.k1) <= 1 && std::abs(h.second - c.k2) <= 1;
+        });
+        if (known) continue;
+        note(c);
+        bridges.push_back(c);
+        ++ev.formed;
+    }
+    for (const Bridge& c : segment_contacts(m, x, B, rc, opt.contact_angle_deg)) {
+        if (partnered.count({c.f1, c.k1, c.f2}) || partnered.count({c.f2, c.k2, c.f1})) continue;
+        note(c);
+        bridges.push_back(c);
+        ++ev.formed;
+    }
+    return ev;
+}
+
+ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, const WetParams& params,
+                          std::vector<Bridge> bridges, Solver& solver, Eigen::VectorXd& q, const ActiveSetOptions& opt) {
+    ActiveSetResult r;
+    auto signature = [](const std::vector<Bridge>& bs) {
+        std::vector<std::array<int, 7>> v;
+        for (const Bridge& b : bs) v.push_back(full_key(b));
+        std::sort(v.begin(), v.end());
+        return v;
+    };
+    std::set<std::vector<std::array<int, 7>>> seen{signature(bridges)};
+    for (int round = 1; round <= opt.max_rounds; ++round) {
+        r.rounds = round;
+        WetEnergy W(dry, F, bridges, params);
+        double t0 = now();
+        r.last = solver.minimize(W, q);
+        r.seconds_solve += now() - t0;
+        r.solver_iterations += r.last.iterations;
+        // An iteration limit is not final: large motions (a fiber zipping onto another) make the set stale long before
+        // the solve ends, so the set is updated and the solve continues with it. Other failures end the loop.
+        const bool limit = r.last.status == SolveStatus::IterationLimit;
+        if (!r.last.converged() && !limit) {
+            r.message = "round " + std::to_string(round) + ": solver " + to_string(r.last.status) + " (" + r.last.message + ")";
+            break;
+        }
+        t0 = now();
+        const WetEvents ev = update_bridges(dry, q, F, bridges, opt);
+        r.per_round.push_back(ev);
+        r.events.moves += ev.moves, r.events.ruptures += ev.ruptures;
+        r.events.formed += ev.formed, r.events.merged += ev.merged, r.events.locked += ev.locked;
+        // Moves, locks and fade-out ruptures leave the energy unchanged near q: if the updated set's gradient at q is
+        // no larger than the one the solver accepted, q is already an equilibrium of it (and beta = 0 stays bit for
+        // bit the dry result).
+        bool equilibrium = false;
+        if (r.last.converged()) {
+            Eigen::VectorXd g;
+            WetEnergy(dry, F, bridges, params).gradient(q, g);
+            equilibrium = g.size() == 0 || g.cwiseAbs().maxCoeff() <= r.last.grad_max * (1 + 1e-9);
+        }
+        r.seconds_events += now() - t0;
+        if (equilibrium) {
+            r.stable = true;
+            r.message = "stable after " + std::to_string(round) + " round(s)";
+            break;
+        }
+        if (!limit && !seen.insert(signature(bridges)).second) {
+            r.cycling = true;
+            r.message = "cycling: the bridge set after round " + std::to_string(round) + " repeats an earlier one";
+            break;
+        }
+        if (round == opt.max_rounds)
+            r.message = "no stable bridge set after " + std::to_string(round) + " rounds (last solve: " +
+                        to_string(r.last.status) + ")";
+    }
+    r.bridges = std::move(bridges);
+    return r;
+}
+
+}  // namespace fibernet

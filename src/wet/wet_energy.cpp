@@ -1,0 +1,129 @@
+#include "fibernet/wet/wet_energy.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <stdexcept>
+
+namespace fibernet {
+
+WetEnergy::WetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, std::vector<Bridge> bridges, WetParams params)
+    : dry_(dry), F_(F), bridges_(std::move(bridges)), params_(std::move(params)) {
+    const Model& m = dry.model();
+    elements_.reserve(bridges_.size());
+    for (const Bridge& b : bridges_) elements_.push_back(resolve(m, b));
+    if (!active()) {
+        pattern_ = dry.hessian_pattern();
+        return;
+    }
+    // Union pattern, column by column.
+    const Eigen::SparseMatrix<double>& P = dry.hessian_pattern();
+    const int n = dry.num_dofs();
+    std::vector<std::vector<int>> cols(n);
+    for (int c = 0; c < n; ++c)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(P, c); it; ++it) cols[c].push_back(static_cast<int>(it.row()));
+    auto local_dof = [&](const BridgeElement& e, int a) { return e.node[a / 2] < 0 ? -1 : dry.dof(e.node[a / 2], a % 2); };
+    for (const BridgeElement& e : elements_)
+        for (int a = 0; a < 16; ++a)
+            for (int b = 0; b < 16; ++b) {
+                const int r = local_dof(e, a), c = local_dof(e, b);
+                if (r >= 0 && c >= 0 && r <= c) cols[c].push_back(r);
+            }
+    std::vector<int> outer(n + 1, 0), inner;
+    for (int c = 0; c < n; ++c) {
+        auto& v = cols[c];
+        std::sort(v.begin(), v.end());
+        v.erase(std::unique(v.begin(), v.end()), v.end());
+        inner.insert(inner.end(), v.begin(), v.end());
+        outer[c + 1] = static_cast<int>(inner.size());
+    }
+    std::vector<double> zeros(inner.size(), 0.0);
+    pattern_ = Eigen::Map<const Eigen::SparseMatrix<double>>(n, n, static_cast<Eigen::Index>(inner.size()), outer.data(),
+                                                            inner.data(), zeros.data());
+    pattern_.makeCompressed();
+    auto slot = [&](int r, int c) {
+        const int* in = pattern_.innerIndexPtr();
+        const int b = pattern_.outerIndexPtr()[c], e = pattern_.outerIndexPtr()[c + 1];
+        const int* it = std::lower_bound(in + b, in + e, r);
+        if (it == in + e || *it != r) throw std::logic_error("wet pattern lacks an entry");
+        return static_cast<int>(it - in);
+    };
+    dry_slot_.reserve(P.nonZeros());
+    for (int c = 0; c < n; ++c)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(P, c); it; ++it) dry_slot_.push_back(slot(static_cast<int>(it.row()), c));
+    bridge_slots_.assign(256 * elements_.size(), -1);
+    for (size_t k = 0; k < elements_.size(); ++k)
+        for (int a = 0; a < 16; ++a)
+            for (int b = 0; b < 16; ++b) {
+                const int r = local_dof(elements_[k], a), c = local_dof(elements_[k], b);
+                if (r >= 0 && c >= 0 && r <= c) bridge_slots_[256 * k + 16 * a + b] = slot(r, c);
+            }
+    dry_H_ = P;
+}
+
+double WetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) {
+    const unsigned want = (g ? kGradient : 0u) | (H ? kHessian : 0u) | (psd ? kProjectPSD : 0u);
+    if (!active()) {  // the dry energy itself: bit for bit
+        dry_.evaluate(q, F_, Eigen::Matrix2d::Zero(), want, eval_, H);
+        if (g) g->swap(eval_.gradient);
+        return eval_.energy;
+    }
+    dry_.evaluate(q, F_, Eigen::Matrix2d::Zero(), want, eval_, H ? &dry_H_ : nullptr);
+    double E = eval_.energy;
+    if (g) g->swap(eval_.gradient);
+    double* hv = nullptr;
+    if (H) {
+        if (H->nonZeros() != pattern_.nonZeros()) throw std::logic_error("Hessian lacks the wet energy's pattern");
+        hv = H->valuePtr();
+        std::fill(hv, hv + H->nonZeros(), 0.0);
+        const double* dv = dry_H_.valuePtr();
+        for (size_t i = 0; i < dry_slot_.size(); ++i) hv[dry_slot_[i]] += dv[i];
+    }
+    const Eigen::VectorXd x = dry_.positions(q, F_);
+    const Eigen::Matrix2d B = F_ * dry_.model().box.B0();
+    Vector16d ge;
+    Matrix16d he;
+    for (size_t k = 0; k < elements_.size(); ++k) {
+        const BridgeElement& e = elements_[k];
+        const Vector16d X = element_coordinates(e, x, B);
+        E += bridge_element_energy(e, X, params_.beta, params_.law, g ? &ge : nullptr, H ? &he : nullptr, psd);
+        if (g)
+            for (int a = 0; a < 16; ++a) {
+                const int r = e.node[a / 2] < 0 ? -1 : dry_.dof(e.node[a / 2], a % 2);
+                if (r >= 0) (*g)[r] += ge[a];
+            }
+        if (H) {
+            const int* sl = &bridge_slots_[256 * k];
+            for (int i = 0; i < 256; ++i)
+                if (sl[i] >= 0) hv[sl[i]] += he(i / 16, i % 16);
+        }
+    }
+    return E;
+}
+
+double WetEnergy::value(const Eigen::VectorXd& q) { return eval(q, nullptr, nullptr, false); }
+double WetEnergy::gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) { return eval(q, &g, nullptr, false); }
+double WetEnergy::hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool psd) {
+    return eval(q, &g, &H, psd);
+}
+
+std::vector<double> WetEnergy::bridge_energies(const Eigen::VectorXd& q) const {
+    std::vector<double> out(elements_.size(), 0.0);
+    if (params_.beta == 0) return out;
+    const Eigen::VectorXd x = dry_.positions(q, F_);
+    const Eigen::Matrix2d B = F_ * dry_.model().box.B0();
+    for (size_t k = 0; k < elements_.size(); ++k)
+        out[k] = bridge_element_energy(elements_[k], element_coordinates(elements_[k], x, B), params_.beta,
+                                       params_.law, nullptr, nullptr);
+    return out;
+}
+
+WetSplit WetEnergy::split(const Eigen::VectorXd& q) const {
+    EnergyEval ev;
+    dry_.evaluate(q, F_, Eigen::Matrix2d::Zero(), kValue, ev);
+    WetSplit s;
+    s.stretch = ev.stretch, s.bend = ev.bend;
+    for (double e : bridge_energies(q)) s.capillary += e;
+    return s;
+}
+
+}  // namespace fibernet

@@ -1,0 +1,203 @@
+// Stress and linear moduli (issue 3): G against the finite-difference slope of sigma_xy from nonlinear solves,
+// K against the slope of the isotropic strain derivative, a floppy network gives G = 0, pruning changes nothing,
+// empty and crosslink-free networks are valid input, and the Cauchy stress is symmetric at an equilibrium.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <utility>
+
+#include "fibernet/box/box.hpp"
+#include "fibernet/mechanics/equilibrium.hpp"
+#include "fibernet/mechanics/moduli.hpp"
+#include "fibernet/mechanics/stress.hpp"
+#include "fibernet/model/discretize.hpp"
+#include "fibernet/model/prune.hpp"
+#include "fibernet/network/mikado.hpp"
+#include "fibernet/solve/newton.hpp"
+
+using namespace fibernet;
+
+namespace {
+
+Model make_model(double L, double q, double pl, double a, std::uint64_t seed, Scheme scheme = Scheme::Even,
+                 PruneOptions prune_opt = {}, double h = 1.0) {
+    MikadoParams mp;
+    mp.L = L, mp.q = q, mp.pl = pl, mp.seed = seed;
+    Network net = generate_mikado(mp);
+    if (prune_opt.dangling || prune_opt.nonspanning) net = prune(net, prune_opt);
+    DiscretizationParams dp;
+    dp.scheme = scheme, dp.aspect_ratio = a, dp.h = h;
+    return discretize(net, dp);
+}
+
+SolverOptions options() {
+    SolverOptions o;
+    o.max_iter = 300;
+    return o;
+}
+
+struct Linear {
+    double G = 0, K = 0, G_aff = 0;
+    bool ok = false;
+};
+
+Linear moduli_at(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F) {
+    Box box = e.model().box;
+    box.F = F;
+    const auto m = linear_moduli(e, q, F, {shear_mode(F, box.area()), bulk_mode(F, box.area())});
+    return {m[0].value, m[1].value, m[0].affine, m[0].ok && m[1].ok};
+}
+
+}  // namespace
+
+TEST_CASE("G equals the central-difference slope of sigma_xy from nonlinear solves", "[moduli][fd]") {
+    struct Case {
+        double L, q, a, gamma0;
+        std::uint64_t seed;
+    };
+    // At the stress-free reference and at a sheared, buckled state (the differential modulus).
+    for (const Case c : {Case{3, 8, 10, 0.0, 7}, Case{3, 10, 3, 0.0, 7}, Case{4, 8, 10, 0.0, 2}, Case{3, 8, 10, 0.01, 7}}) {
+        const Model m = make_model(c.L, c.q, 1.0, c.a, c.seed);
+        NetworkEnergy e(m);
+        NewtonSolver newton(options());
+        const Eigen::Matrix2d F0 = deformation(StrainKind::Shear, c.gamma0);
+        const Equilibrium eq0 = relax(e, F0, newton);
+        REQUIRE(eq0.converged());
+        const Linear lin = moduli_at(e, eq0.q, F0);
+        REQUIRE(lin.ok);
+        REQUIRE(lin.G > 0);
+        const double dg = 1e-5;
+        double s[2];
+        for (int k = 0; k < 2; ++k) {
+            const Eigen::Matrix2d F = deformation(StrainKind::Shear, c.gamma0 + (k ? dg : -dg));
+            const Equilibrium eq = relax(e, F, newton, &eq0.q, F0);  // affinely mapped start
+            REQUIRE(eq.converged());
+            s[k] = stress(e, eq.q, F).sigma(0, 1);
+        }
+        const double fd = (s[1] - s[0]) / (2 * dg);
+        INFO("L " << c.L << " q " << c.q << " a " << c.a << " gamma0 " << c.gamma0 << ": G " << lin.G << " FD " << fd
+                  << " G/G_aff " << lin.G / lin.G_aff);
+        CHECK(std::abs(fd - lin.G) <= 1e-5 * std::abs(lin.G));
+    }
+}
+
+TEST_CASE("K equals the slope of the isotropic strain derivative", "[moduli][fd]") {
+    const Model m = make_model(3, 8, 1.0, 10, 7);
+    NetworkEnergy e(m);
+    NewtonSolver newton(options());
+    const Equilibrium eq0 = relax(e, Eigen::Matrix2d::Identity(), newton);
+    REQUIRE(eq0.converged());
+    const Linear lin = moduli_at(e, eq0.q, Eigen::Matrix2d::Identity());
+    REQUIRE(lin.ok);
+    // K = A d2E/dA2 = (1/(4 A0)) d2E/dt2 along F = (1 + t) I at the stress-free state (moduli.hpp).
+    const double h = 1e-5, A0 = m.box.reference_area();
+    double dEdt[2];
+    for (int k = 0; k < 2; ++k) {
+        const Eigen::Matrix2d F = deformation(StrainKind::Isotropic, k ? h : -h);
+        const Equilibrium eq = relax(e, F, newton, &eq0.q);
+        REQUIRE(eq.converged());
+        EnergyEval ev;
+        // F(t) = I + t I, so dE/dt = P : I at fixed q (stress.hpp).
+        e.evaluate(eq.q, F, Eigen::Matrix2d::Identity(), kStrain, ev);
+        dEdt[k] = ev.dE_dt;
+    }
+    const double fd = (dEdt[1] - dEdt[0]) / (2 * h) / (4 * A0);
+    INFO("K " << lin.K << " FD " << fd);
+    CHECK(std::abs(fd - lin.K) <= 1e-5 * std::abs(lin.K));
+}
+
+TEST_CASE("stress: sigma_xy = (1/A) dE/dgamma and sigma is symmetric at an equilibrium", "[stress]") {
+    const Model m = make_model(3, 8, 1.0, 10, 7);
+    NetworkEnergy e(m);
+    NewtonSolver newton(options());
+    const Eigen::Matrix2d F = deformation(StrainKind::Shear, 0.02);
+    const Equilibrium eq = relax(e, F, newton);
+    REQUIRE(eq.converged());
+    const Stress st = stress(e, eq.q, F);
+    EnergyEval ev;
+    e.evaluate(eq.q, F, strain_direction(StrainKind::Shear), kStrain, ev);
+    CHECK(st.sigma(0, 1) == Approx(ev.dE_dt / st.area).epsilon(1e-12));
+    CHECK(std::abs(st.sigma(0, 1) - st.sigma(1, 0)) <= 1e-8 * std::abs(st.sigma(0, 1)));
+    CHECK(st.sigma(0, 1) > 0);
+}
+
+TEST_CASE("a floppy network (q = 2, below percolation) has G = 0 and K = 0", "[moduli][floppy]") {
+    // Tolerance: |G| <= 1e-9 G_affine. G = E_tt - c cancels two numbers of size E_tt; round-off leaves ~1e-13 G_aff.
+    for (std::uint64_t seed : {1, 2, 3}) {
+        const Model m = make_model(4, 2, 1.0, 10, seed);
+        NetworkEnergy e(m);
+        NewtonSolver newton(options());
+        const Equilibrium eq = relax(e, deformation(StrainKind::Shear, 0.01), newton);
+        REQUIRE(eq.converged());
+        CHECK(eq.energy <= 1e-12);  // every cluster relaxes to zero energy by rigid motions
+        const Linear lin = moduli_at(e, eq.q, deformation(StrainKind::Shear, 0.01));
+        REQUIRE(lin.ok);
+        CHECK(lin.G_aff > 1);
+        CHECK(std::abs(lin.G) <= 1e-9 * lin.G_aff);
+        CHECK(std::abs(lin.K) <= 1e-9 * lin.G_aff);
+    }
+}
+
+// Pruning works on the Network, before discretization: a dropped fiber's crosslink on a kept fiber is no longer a
+// node there, so the kept fiber is split differently and G moves by the discretization error (measured on L = 4,
+// q = 8, pl = 0.9, seed 5, even scheme: 1.1e-4 at h = 1, 1.9e-5 at 0.5, 1.6e-7 at 0.25, 1.2e-9 at 0.125). The
+// mechanics is unchanged: at h = 0.125 (and for seed 3, whose dropped fibers pin nothing that is kept) the results
+// agree to 1e-7 at the reference state.
+TEST_CASE("pruning dangling fibers and non-spanning clusters changes neither G nor K", "[moduli][prune]") {
+    for (const auto& [seed, h] : {std::pair<std::uint64_t, double>{3, 1.0}, {5, 0.125}}) {
+        const Model full = make_model(4, 8, 0.9, 10, seed, Scheme::Even, {}, h);
+        const Model pruned = make_model(4, 8, 0.9, 10, seed, Scheme::Even, PruneOptions{true, true}, h);
+        REQUIRE(pruned.chains.size() < full.chains.size());
+        NetworkEnergy ef(full), ep(pruned);
+        NewtonSolver newton(options());
+        for (double gamma : {0.0, 0.01}) {
+            const Eigen::Matrix2d F = deformation(StrainKind::Shear, gamma);
+            const Equilibrium a = relax(ef, F, newton), b = relax(ep, F, newton);
+            REQUIRE(a.converged());
+            REQUIRE(b.converged());
+            const Linear la = moduli_at(ef, a.q, F), lb = moduli_at(ep, b.q, F);
+            REQUIRE(la.ok);
+            REQUIRE(lb.ok);
+            REQUIRE(la.G > 1e-6 * la.G_aff);  // a rigid network: the comparison is not 0 == 0
+            INFO("seed " << seed << " gamma " << gamma << ": G " << la.G << " vs " << lb.G << ", K " << la.K << " vs "
+                         << lb.K);
+            // At gamma = 0.01 fibers have buckled and the leftover discretization difference shows more (1e-6 to
+            // 3e-6 measured, depending on the Newton path): checked at 1e-5 there.
+            const double tol = gamma == 0 ? 1e-7 : 1e-5;
+            CHECK(lb.G == Approx(la.G).epsilon(tol));
+            CHECK(lb.K == Approx(la.K).epsilon(tol));
+            // Margins: at gamma = 0 both are round-off (~1e-13; the bending term can come out -1e-13).
+            CHECK(b.energy == Approx(a.energy).epsilon(1e-7).margin(1e-11));
+            CHECK(stress(ep, b.q, F).sigma(0, 1) == Approx(stress(ef, a.q, F).sigma(0, 1)).epsilon(1e-7).margin(1e-11));
+        }
+    }
+}
+
+TEST_CASE("an empty network and one without crosslinks have G = 0, no crash", "[moduli][edge]") {
+    NewtonSolver newton(options());
+    {
+        Network net;
+        net.L = 3;
+        const Model m = discretize(net, DiscretizationParams{});
+        NetworkEnergy e(m);
+        const Equilibrium eq = relax(e, deformation(StrainKind::Shear, 0.01), newton);
+        REQUIRE(eq.converged());
+        const Linear lin = moduli_at(e, eq.q, deformation(StrainKind::Shear, 0.01));
+        CHECK(lin.ok);
+        CHECK(lin.G == 0);
+        CHECK(lin.K == 0);
+    }
+    {
+        const Model m = make_model(3, 8, 0.0, 10, 5);  // pl = 0: fibers cross but nothing pins them
+        REQUIRE(m.supernodes.empty());
+        NetworkEnergy e(m);
+        const Equilibrium eq = relax(e, deformation(StrainKind::Shear, 0.01), newton);
+        REQUIRE(eq.converged());
+        const Linear lin = moduli_at(e, eq.q, deformation(StrainKind::Shear, 0.01));
+        CHECK(lin.ok);
+        CHECK(lin.G_aff > 1);
+        // Free fibers: H has a 3-per-fiber null space (216 here) and CG stops on round-off near 1e-9 G_aff.
+        CHECK(std::abs(lin.G) <= 1e-8 * lin.G_aff);
+    }
+}

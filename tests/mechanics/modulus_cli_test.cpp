@@ -1,0 +1,92 @@
+// `fibernet modulus` and `fibernet relax` end to end: JSON, exit codes (0 converged, 1 not converged with moduli
+// null, 2 bad input), the equilibrium model file, and the valid answers for empty and crosslink-free networks.
+#include <catch2/catch.hpp>
+
+#include <cstdlib>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace {
+std::string dir() {
+    static std::string d = [] {
+        char tmpl[] = "/tmp/fibernet_modulus_XXXXXX";
+        return std::string(mkdtemp(tmpl));
+    }();
+    return d;
+}
+int run(const std::string& args) {
+    const std::string cmd = std::string(FIBERNET_EXE) + " " + args + " >" + dir() + "/stdout 2>" + dir() + "/stderr";
+    const int rc = std::system(cmd.c_str());
+    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+std::string slurp(const std::string& p) {
+    std::ifstream is(p);
+    return std::string((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
+}
+nlohmann::json out() { return nlohmann::json::parse(slurp(dir() + "/stdout")); }
+}  // namespace
+
+TEST_CASE("cli modulus: converged JSON with moduli, energy split, sizes and timings", "[cli][modulus]") {
+    REQUIRE(run("modulus --L 3 --q 8 --scheme even --a 10 --seed 7") == 0);
+    const auto j = out();
+    CHECK(j["status"] == "converged");
+    CHECK(j["moduli"]["G"].is_number());
+    CHECK(j["moduli"]["G"].get<double>() > 0);
+    CHECK(j["moduli"]["K"].is_number());
+    CHECK(j["moduli"]["G_ratio"].get<double>() ==
+          Approx(j["moduli"]["G"].get<double>() / j["moduli"]["G_affine"].get<double>()));
+    CHECK(j["energy"].contains("stretch"));
+    CHECK(j["energy"].contains("bend"));
+    CHECK(j["model"]["dofs"].get<int>() > 0);
+    CHECK(j["network"]["fibers"].get<int>() == 72);
+    CHECK(j["solver"]["status"] == "converged");
+    CHECK(j["solver"]["seconds"].contains("factorization"));
+    CHECK(j["linear_solve"]["factorizations"].get<int>() == 1);
+}
+
+TEST_CASE("cli modulus: the default scene converges", "[cli][modulus]") {
+    REQUIRE(run(std::string(FIBERNET_SOURCE_DIR) + "/problems/default.toml") == 2);  // a scene alone is no command
+    REQUIRE(run("modulus " + std::string(FIBERNET_SOURCE_DIR) + "/problems/default.toml") == 0);
+    CHECK(out()["moduli"]["G"].get<double>() > 0);
+}
+
+TEST_CASE("cli modulus: a solver that does not converge exits 1 and prints no modulus", "[cli][modulus]") {
+    REQUIRE(run("modulus --L 3 --q 8 --scheme even --gamma 0.05 --max-iter 1") == 1);
+    const auto j = out();
+    CHECK(j["status"] == "iteration_limit");
+    CHECK(j["moduli"].is_null());
+    CHECK(j["stress"].is_null());
+}
+
+TEST_CASE("cli modulus: bad input exits 2", "[cli][modulus][input]") {
+    CHECK(run("modulus --L 3 --q 8 --solver nope") == 2);
+    CHECK(slurp(dir() + "/stderr").find("nope") != std::string::npos);
+    CHECK(run("modulus --L 3 --q -1") == 2);
+    CHECK(run("modulus --L 3 --q 8 --tol 0") == 2);
+}
+
+TEST_CASE("cli modulus: empty and crosslink-free networks give G = 0", "[cli][modulus][edge]") {
+    REQUIRE(run("modulus --L 3 --q 0.01") == 0);  // round(0.01 * 9) = 0 fibers
+    auto j = out();
+    CHECK(j["network"]["fibers"] == 0);
+    CHECK(j["moduli"]["G"].get<double>() == 0);
+    CHECK(j["moduli"]["G_ratio"].is_null());  // 0 / 0
+    REQUIRE(run("modulus --L 3 --q 8 --pl 0 --gamma 0.01") == 0);
+    j = out();
+    CHECK(std::abs(j["moduli"]["G"].get<double>()) <= 1e-8 * j["moduli"]["G_affine"].get<double>());
+}
+
+TEST_CASE("cli relax: writes the equilibrium model and its stress", "[cli][relax]") {
+    const std::string model = dir() + "/relaxed.txt";
+    REQUIRE(run("relax --L 3 --q 8 --scheme even --gamma 0.01 -o " + model) == 0);
+    const auto j = out();
+    CHECK(j["status"] == "converged");
+    CHECK(j["stress"]["xy"].get<double>() > 0);
+    CHECK(slurp(model).rfind("fibernet-model 1\n", 0) == 0);
+    const std::string bad = dir() + "/not_written.txt";
+    REQUIRE(run("relax --L 3 --q 8 --scheme even --gamma 0.05 --max-iter 1 -o " + bad) == 1);
+    CHECK_FALSE(std::ifstream(bad).good());
+}

@@ -1,0 +1,193 @@
+// Mobility and events (issue 6, part 2): bridges follow their crossing across nodes without an energy jump, rupture
+// continuously off a fiber end, form at new crossings and contacts; the outer loop terminates and reports.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "fibernet/wet/active_set.hpp"
+#include "fibernet/wet/wet_energy.hpp"
+#include "wet_fixtures.hpp"
+
+using namespace fibernet;
+using namespace wetfix;
+
+namespace {
+const Eigen::Matrix2d I2 = Eigen::Matrix2d::Identity();
+
+// q with fiber f's nodes moved by (dx, dy) (seed units) from q0.
+Eigen::VectorXd moved(const NetworkEnergy& e, Eigen::VectorXd q, int f, double dx, double dy) {
+    for (int n : e.model().chains[f].nodes) q[e.dof(n, 0)] += dx, q[e.dof(n, 1)] += dy;
+    return q;
+}
+
+double capillary(const NetworkEnergy& e, const Eigen::VectorXd& q, const std::vector<Bridge>& b, const WetParams& p) {
+    double s = 0;
+    for (double v : WetEnergy(e, I2, b, p).bridge_energies(q)) s += v;
+    return s;
+}
+
+struct Drag {
+    std::vector<double> E;     // capillary energy after each update
+    double max_switch = 0;     // largest |E(new set) - E(old set)| at one state
+    double max_step = 0;       // largest |E_k+1 - E_k|
+    WetEvents events;
+};
+
+// Drags fiber f by (dx, dy) per step; updates the bridges at every state (no formation).
+Drag drag(const NetworkEnergy& e, Eigen::VectorXd q, std::vector<Bridge>& bridges, int f, double dx, double dy, int steps,
+          const WetParams& p) {
+    Drag d;
+    ActiveSetOptions opt;
+    opt.form_new = false;
+    for (int i = 0; i <= steps; ++i) {
+        const Eigen::VectorXd qi = moved(e, q, f, i * dx, i * dy);
+        const double before = capillary(e, qi, bridges, p);
+        const WetEvents ev = update_bridges(e, qi, I2, bridges, opt);
+        d.events.moves += ev.moves, d.events.ruptures += ev.ruptures;
+        const double after = capillary(e, qi, bridges, p);
+        d.max_switch = std::max(d.max_switch, std::abs(after - before));
+        if (!d.E.empty()) d.max_step = std::max(d.max_step, std::abs(after - d.E.back()));
+        d.E.push_back(after);
+    }
+    return d;
+}
+}  // namespace
+
+TEST_CASE("active set: a bridge dragged across a kinked node moves without an energy jump", "[wet][events]") {
+    // Fiber 1 along x from 10 to 20 (nodes at integers), kinked by 15 deg at x = 13; fiber 2 at 60 deg crosses at 12.5.
+    const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.25, 1.5, 60, 1, 0.45}}, 3);
+    const Model m = model_of(net);
+    NetworkEnergy e(m);
+    Eigen::VectorXd q = e.dofs(m.x);
+    const double kink = 15 * M_PI / 180;
+    for (int n : m.chains[0].nodes) {
+        const double x = q[e.dof(n, 0)] - 13, y = q[e.dof(n, 1)] - 15;
+        if (x > 1e-9) q[e.dof(n, 0)] = 13 + std::cos(kink) * x - std::sin(kink) * y, q[e.dof(n, 1)] = 15 + std::sin(kink) * x + std::cos(kink) * y;
+    }
+    std::vector<Bridge> bridges = wet_crossings(net, m, e.positions(q, I2), m.box.B0(), {});
+    REQUIRE(bridges.size() == 1);
+    CHECK(bridges[0].k1 == 2);
+    WetParams p;
+    p.beta = 1;
+    const Drag d = drag(e, q, bridges, 1, 0.0047, 0, 213, p);  // steps miss the node itself
+    REQUIRE(bridges.size() == 1);
+    CHECK(bridges[0].k1 == 3);       // it moved to the next segment of fiber 1
+    CHECK(d.events.moves >= 1);
+    CHECK(d.max_switch < 1e-12);     // moving the bridge changes no energy
+    // Without blending the move would jump by beta l |cos^2 60 - cos^2 45| = 0.25; the blended path is smooth.
+    CHECK(d.E.front() == Approx(-0.25).epsilon(1e-9));
+    CHECK(d.E.back() == Approx(-0.5).epsilon(1e-9));
+    CHECK(d.max_step < 0.04 * 0.25);  // the 0.25 change is spread over the blend zone (2 delta = 0.5, 100 steps)
+}
+
+TEST_CASE("active set: sliding along a straight fiber keeps the capillary energy", "[wet][events]") {
+    // Fiber 2 translated along its own axis: its crossing slides along fiber 2 across nodes (equal segments).
+    const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.55, 1.5, 70, 1, 0.45}}, 3);
+    const Model m = model_of(net);
+    NetworkEnergy e(m);
+    const Eigen::VectorXd q = e.dofs(m.x);
+    std::vector<Bridge> bridges = wet_crossings(net, m, m.x, m.box.B0(), {});
+    WetParams p;
+    p.beta = 2;
+    const double c = std::cos(70 * M_PI / 180), s = std::sin(70 * M_PI / 180);
+    const Drag d = drag(e, q, bridges, 1, 0.01 * c, 0.01 * s, 150, p);
+    CHECK(d.events.moves >= 1);
+    for (double E : d.E) CHECK(E == Approx(d.E.front()).epsilon(1e-12));
+}
+
+TEST_CASE("active set: a bridge sliding off a fiber end fades out and ruptures", "[wet][events]") {
+    // Fiber 2 crosses fiber 1 at x = 10.5, then is dragged to x = 9.5, past fiber 1's start at x = 10.
+    const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.05, 1.5, 60, 1, 0.45}}, 3);
+    const Model m = model_of(net);
+    NetworkEnergy e(m);
+    std::vector<Bridge> bridges = wet_crossings(net, m, m.x, m.box.B0(), {});
+    REQUIRE(bridges.size() == 1);
+    WetParams p;
+    p.beta = 1;
+    const Drag d = drag(e, e.dofs(m.x), bridges, 1, -0.005, 0, 200, p);
+    CHECK(d.events.ruptures == 1);
+    CHECK(bridges.empty());
+    CHECK(d.max_switch < 1e-12);   // the bridge's weight was zero when it ruptured
+    CHECK(d.E.front() == Approx(-0.25));
+    CHECK(d.E[100] == Approx(-0.125));  // crossing at the fiber end: half the weight
+    CHECK(d.max_step < 0.02 * 0.25);
+}
+
+TEST_CASE("active set: a new crossing gets a bridge", "[wet][events]") {
+    // Fiber 3 (parallel to fiber 2) ends short of fiber 1 until it is dragged across it.
+    const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.5, 1.5, 60, 1, 0.45}, {1.5, 1.2, 90, 1, 1.0}}, 3);
+    const Model m = model_of(net);
+    NetworkEnergy e(m);
+    std::vector<Bridge> bridges = wet_crossings(net, m, m.x, m.box.B0(), {});
+    REQUIRE(bridges.size() == 1);
+    const Eigen::VectorXd q = moved(e, e.dofs(m.x), 2, 0.3, 3.5);
+    const WetEvents ev = update_bridges(e, q, I2, bridges);
+    CHECK(ev.formed == 1);
+    REQUIRE(bridges.size() == 2);
+    const Bridge& b = bridges[1];
+    CHECK(b.f1 == 0);
+    CHECK(b.f2 == 2);
+    const BridgeElement el = resolve(m, b);
+    const CrossingPosition cp = crossing_position(el, element_coordinates(el, e.positions(q, I2), m.box.B0()));
+    CHECK(cp.inside(0));
+    CHECK(cp.inside(1));
+}
+
+TEST_CASE("active set: zipped fibers hold one bridge per segment pair, adhesion -beta per unit overlap", "[wet][bundle]") {
+    // Two parallel fibers 0.05 apart (in contact: fiber diameter 2/a = 0.2), fiber 2 shifted along by `offset`.
+    for (int nseg : {10, 20, 40})
+        for (double offset : {0.33, 0.5, 0.71}) {
+            const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.5 + offset, 1.505, 0, 1, 0.5}}, 3);
+            const Model m = model_of(net, nseg);
+            NetworkEnergy e(m);
+            std::vector<Bridge> bridges;
+            const WetEvents ev = update_bridges(e, e.dofs(m.x), I2, bridges);
+            WetParams p;
+            p.beta = 3;
+            const double overlap = 10 * (1 - offset);
+            const double E = capillary(e, e.dofs(m.x), bridges, p);
+            INFO("n_seg " << nseg << ", offset " << offset << ": " << bridges.size() << " bridges, E / (beta overlap) = "
+                          << E / (p.beta * overlap));
+            CHECK(ev.formed == static_cast<int>(bridges.size()));
+            CHECK(std::abs(E / (-p.beta * overlap) - 1) < 0.05);
+        }
+}
+
+namespace {
+// A stand-in solver that alternates between two given states (and reports convergence): the bridge set it leaves
+// behind alternates too, which the loop must report as cycling instead of running to max_rounds.
+class Alternating : public Solver {
+public:
+    Alternating(Eigen::VectorXd a, Eigen::VectorXd b) : s_{std::move(a), std::move(b)} {}
+    std::string name() const override { return "alternating"; }
+    SolveResult minimize(Objective&, Eigen::VectorXd& q) override {
+        q = s_[k_++ % 2];
+        SolveResult r;
+        r.status = SolveStatus::Converged;
+        r.grad_max = 0;
+        return r;
+    }
+
+private:
+    Eigen::VectorXd s_[2];
+    int k_ = 0;
+};
+}  // namespace
+
+TEST_CASE("active set: a bridge set that repeats is reported as cycling", "[wet][events]") {
+    const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.45, 1.5, 60, 1, 0.45}}, 3);
+    const Model m = model_of(net);
+    NetworkEnergy e(m);
+    const Eigen::VectorXd q0 = e.dofs(m.x);
+    Alternating solver(moved(e, q0, 1, -2, 0), moved(e, q0, 1, -1, 0));  // crossing at x = 12.5, then 13.5
+    WetParams p;
+    p.beta = 1;
+    Eigen::VectorXd q = q0;
+    ActiveSetOptions opt;
+    opt.form_new = false;
+    const ActiveSetResult r = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver, q, opt);
+    CHECK(r.cycling);
+    CHECK(!r.stable);
+    CHECK(r.rounds == 3);
+    CHECK(r.message.find("cycling") != std::string::npos);
+    CHECK(r.events.moves >= 3);
+}

@@ -1,0 +1,149 @@
+// Derivatives of the wet energy (dry + blended bridges) against central differences, on hand-made crossings placed
+// inside and outside the blend zones, at fiber ends, across periodic boundaries and in a sheared box.
+#include <catch2/catch.hpp>
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "../energy/fd.hpp"
+#include "fibernet/wet/active_set.hpp"
+#include "fibernet/wet/wet_energy.hpp"
+#include "wet_fixtures.hpp"
+
+using namespace fibernet;
+using namespace wetfix;
+
+namespace {
+void check_derivatives(const Model& m, const Eigen::Matrix2d& F, double amp, std::uint64_t seed, const CapillaryLaw& law,
+                       int min_bridges) {
+    NetworkEnergy dry(m);
+    const Eigen::Matrix2d B = F * m.box.B0();
+    Eigen::VectorXd q = dry.affine_map(dry.dofs(m.x), Eigen::Matrix2d::Identity(), F);
+    q = perturb(q, amp, seed);
+    WettingRule all;
+    // Network crossings need the network; here every intersecting segment pair gets a bridge.
+    std::vector<Bridge> bridges = segment_crossings(m, dry.positions(q, F), B);
+    REQUIRE(static_cast<int>(bridges.size()) >= min_bridges);
+    WetParams p;
+    p.beta = 2.5, p.law = law;
+    WetEnergy W(dry, F, bridges, p);
+    Eigen::VectorXd g;
+    Eigen::SparseMatrix<double> H = W.hessian_pattern();
+    W.hessian(q, g, H, false);
+    const Eigen::MatrixXd Hu(H);
+    const Eigen::MatrixXd Hf = Eigen::MatrixXd(Hu.selfadjointView<Eigen::Upper>());
+    auto val = [&](const Eigen::VectorXd& v) { return W.value(v); };
+    auto grad = [&](const Eigen::VectorXd& v) {
+        Eigen::VectorXd r;
+        W.gradient(v, r);
+        return r;
+    };
+    // The capillary part alone must also pass (the dry part is much stiffer and would hide an error in it).
+    WetParams p0 = p;
+    p0.beta = 0;
+    WetEnergy D(dry, F, bridges, p0);
+    Eigen::VectorXd gd;
+    Eigen::SparseMatrix<double> Hd = D.hessian_pattern();
+    D.hessian(q, gd, Hd, false);
+    const Eigen::MatrixXd Hdu(Hd);
+    const Eigen::MatrixXd Hcap = Hf - Eigen::MatrixXd(Hdu.selfadjointView<Eigen::Upper>());
+    auto capval = [&](const Eigen::VectorXd& v) { return W.value(v) - D.value(v); };
+    auto capgrad = [&](const Eigen::VectorXd& v) {
+        Eigen::VectorXd a, b;
+        W.gradient(v, a), D.gradient(v, b);
+        return Eigen::VectorXd(a - b);
+    };
+    const double h = 1e-6;
+    CHECK(fdtest::rel_err(g, fdtest::fd_gradient(val, q, h)) < 1e-6);
+    CHECK(fdtest::rel_err(Hf, fdtest::fd_jacobian(grad, q, h)) < 1e-6);
+    CHECK(fdtest::rel_err(g - gd, fdtest::fd_gradient(capval, q, h), 1e-3) < 1e-6);
+    CHECK(fdtest::rel_err(Hcap, fdtest::fd_jacobian(capgrad, q, h), 1e-3) < 1e-5);
+}
+
+CapillaryLaw table() {
+    std::vector<double> a, v;
+    for (int i = 0; i <= 18; ++i) {
+        const double r = 5.0 * i * M_PI / 180;
+        a.push_back(5.0 * i), v.push_back(-std::cos(r) * std::cos(r) + 0.1 * std::sin(2 * r) * std::sin(2 * r));
+    }
+    return CapillaryLaw::tabulated(a, v, "test table");
+}
+}  // namespace
+
+TEST_CASE("wet energy: gradient and Hessian match finite differences", "[wet][gradient][hessian]") {
+    const CapillaryLaw def, tab = table();
+    // Fiber 1 along x with nodes every 0.1; fiber 2 crosses it 0.01 (blend zone: |z| < 0.025) past a node.
+    SECTION("blend zone on one fiber") {
+        const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.31, 1.5, 60, 1, 0.45}}, 3));
+        for (int s = 0; s < 3; ++s) check_derivatives(m, Eigen::Matrix2d::Identity(), 0.003, 11 + s, def, 1);
+        check_derivatives(m, Eigen::Matrix2d::Identity(), 0.003, 21, tab, 1);
+    }
+    SECTION("blend zones on both fibers") {
+        const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.31, 1.5, 70, 1, 0.41}}, 3));
+        for (int s = 0; s < 3; ++s) check_derivatives(m, Eigen::Matrix2d::Identity(), 0.003, 31 + s, def, 1);
+    }
+    SECTION("crossing near a fiber end (missing neighbour)") {
+        const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.005, 1.5, 50, 1, 0.5}}, 3));
+        for (int s = 0; s < 3; ++s) check_derivatives(m, Eigen::Matrix2d::Identity(), 0.002, 41 + s, def, 1);
+    }
+    SECTION("interior crossings, several fibers") {
+        const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.55, 1.5, 60, 1, 0.45}, {1.5, 1.55, 100, 1, 0.5}}, 3));
+        check_derivatives(m, Eigen::Matrix2d::Identity(), 0.01, 51, def, 3);
+        check_derivatives(m, Eigen::Matrix2d::Identity(), 0.01, 52, tab, 3);
+    }
+    SECTION("crossings across the periodic boundary, sheared box") {
+        // Both crossings sit on the box edge x = 0 = L; fiber 1 wraps around it.
+        const Model m = model_of(network_of({{0.02, 1.0, 10, 1, 0.5}, {0.01, 1.03, 80, 1, 0.5}}, 2));
+        Eigen::Matrix2d F;
+        F << 1, 0.3, 0, 1.1;
+        check_derivatives(m, F, 0.003, 61, def, 1);
+        check_derivatives(m, Eigen::Matrix2d::Identity(), 0.003, 62, tab, 1);
+    }
+    SECTION("a random Mikado network, seed scheme (short segments)") {
+        const Network net = mikado(2.5, 4, 0.5, 7);
+        const Model m = model_of(net, 4);
+        check_derivatives(m, Eigen::Matrix2d::Identity(), 0.002, 71, def, 5);
+    }
+}
+
+TEST_CASE("wet energy: beta = 0 is the dry energy bit for bit", "[wet]") {
+    const Model m = model_of(mikado(2.5, 4, 0.5, 3), 4);
+    NetworkEnergy dry(m);
+    const Eigen::VectorXd q = perturb(dry.dofs(m.x), 0.01, 5);
+    WetParams p;  // beta = 0
+    WetEnergy W(dry, Eigen::Matrix2d::Identity(), segment_crossings(m, dry.positions(q, Eigen::Matrix2d::Identity()), m.box.B0()), p);
+    REQUIRE(!W.bridges().empty());
+    StrainedEnergy S(dry, Eigen::Matrix2d::Identity());
+    Eigen::VectorXd gw, gs;
+    Eigen::SparseMatrix<double> Hw = W.hessian_pattern(), Hs = S.hessian_pattern();
+    const double ew = W.hessian(q, gw, Hw, false), es = S.hessian(q, gs, Hs, false);
+    CHECK(ew == es);
+    CHECK((gw.array() == gs.array()).all());
+    REQUIRE(Hw.nonZeros() == Hs.nonZeros());
+    CHECK(std::equal(Hw.valuePtr(), Hw.valuePtr() + Hw.nonZeros(), Hs.valuePtr()));
+    CHECK(std::equal(Hw.innerIndexPtr(), Hw.innerIndexPtr() + Hw.nonZeros(), Hs.innerIndexPtr()));
+}
+
+TEST_CASE("wet energy: the projected Hessian is positive semidefinite", "[wet][hessian]") {
+    // Crossings in and out of blend zones (both Hessian paths), bent by a perturbation.
+    const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.31, 1.5, 70, 1, 0.41}, {1.55, 1.5, 60, 1, 0.45},
+                                         {1.5, 1.55, 100, 1, 0.5}}, 3));
+    NetworkEnergy dry(m);
+    const Eigen::VectorXd q = perturb(dry.dofs(m.x), 0.01, 81);
+    WetParams p;
+    p.beta = 5;
+    WetEnergy W(dry, Eigen::Matrix2d::Identity(), segment_crossings(m, dry.positions(q, Eigen::Matrix2d::Identity()), m.box.B0()), p);
+    REQUIRE(W.bridges().size() >= 4);
+    Eigen::VectorXd g;
+    Eigen::SparseMatrix<double> H = W.hessian_pattern();
+    W.hessian(q, g, H, true);
+    const Eigen::MatrixXd Hu(H);
+    const Eigen::MatrixXd Hf = Eigen::MatrixXd(Hu.selfadjointView<Eigen::Upper>());
+    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Hf).eigenvalues();
+    CHECK(ev.minCoeff() > -1e-9 * ev.maxCoeff());
+    // Without projection the bridges make it indefinite here (so the check above can fail).
+    W.hessian(q, g, H, false);
+    const Eigen::MatrixXd Hu2(H);
+    const Eigen::VectorXd ev2 =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Eigen::MatrixXd(Hu2.selfadjointView<Eigen::Upper>())).eigenvalues();
+    CHECK(ev2.minCoeff() < -1e-6);
+}
