@@ -52,5 +52,6 @@ void register_percolation(CLI::App& app);
 void register_modulus(CLI::App& app);
 void register_relax(CLI::App& app);
 void register_wet(CLI::App& app);
+void register_sweep(CLI::App& app);
 
 }  // namespace fibernet::cli

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
     cli::register_modulus(app);
     cli::register_relax(app);
     cli::register_wet(app);
+    cli::register_sweep(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
