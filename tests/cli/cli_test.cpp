@@ -1,5 +1,7 @@
 // End-to-end checks of the `fibernet` executable: outputs, exit codes, and bad input (exit 2, no output file).
 #include <catch2/catch.hpp>
+
+#include "../support/cli_run.hpp"
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -7,25 +9,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-namespace {
-std::string tmpdir() {
-    static std::string d = [] {
-        char tmpl[] = "/tmp/fibernet_cli_XXXXXX";
-        return std::string(mkdtemp(tmpl));
-    }();
-    return d;
-}
-int run(const std::string& args) {
-    const std::string cmd = std::string(FIBERNET_EXE) + " " + args + " >" + tmpdir() + "/stdout 2>" + tmpdir() + "/stderr";
-    const int rc = std::system(cmd.c_str());
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-std::string slurp(const std::string& p) {
-    std::ifstream is(p);
-    return std::string((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
-}
-bool exists(const std::string& p) { return std::ifstream(p).good(); }
-}  // namespace
+using clitest::exists;
+using clitest::run;
+using clitest::slurp;
+using clitest::tmpdir;
 
 TEST_CASE("cli: generate and export write documented files", "[cli]") {
     const std::string net = tmpdir() + "/net.txt", model = tmpdir() + "/model.txt";

@@ -2,6 +2,8 @@
 // null, 2 bad input), the equilibrium model file, and the valid answers for empty and crosslink-free networks.
 #include <catch2/catch.hpp>
 
+#include "../support/cli_run.hpp"
+
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -10,22 +12,9 @@
 #include <unistd.h>
 
 namespace {
-std::string dir() {
-    static std::string d = [] {
-        char tmpl[] = "/tmp/fibernet_modulus_XXXXXX";
-        return std::string(mkdtemp(tmpl));
-    }();
-    return d;
-}
-int run(const std::string& args) {
-    const std::string cmd = std::string(FIBERNET_EXE) + " " + args + " >" + dir() + "/stdout 2>" + dir() + "/stderr";
-    const int rc = std::system(cmd.c_str());
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-std::string slurp(const std::string& p) {
-    std::ifstream is(p);
-    return std::string((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
-}
+using clitest::run;
+using clitest::slurp;
+std::string dir() { return clitest::tmpdir(); }
 nlohmann::json out() { return nlohmann::json::parse(slurp(dir() + "/stdout")); }
 }  // namespace
 

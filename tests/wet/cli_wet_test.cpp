@@ -1,5 +1,7 @@
 // `fibernet wet` end to end on a tiny network, and bad input: exit 2, a message naming the value, no output files.
 #include <catch2/catch.hpp>
+
+#include "../support/cli_run.hpp"
 #include <cstdlib>
 #include <fstream>
 #include <string>
@@ -7,24 +9,11 @@
 #include <unistd.h>
 
 namespace {
-std::string tmpdir() {
-    static std::string d = [] {
-        char tmpl[] = "/tmp/fibernet_wet_XXXXXX";
-        return std::string(mkdtemp(tmpl));
-    }();
-    return d;
-}
-int run(const std::string& args) {
-    const std::string cmd = std::string(FIBERNET_EXE) + " wet " + args + " >" + tmpdir() + "/stdout 2>" + tmpdir() + "/stderr";
-    const int rc = std::system(cmd.c_str());
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-std::string slurp(const std::string& p) {
-    std::ifstream is(p);
-    return std::string((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
-}
-bool exists(const std::string& p) { return std::ifstream(p).good(); }
-void write(const std::string& p, const std::string& s) { std::ofstream(p) << s; }
+using clitest::exists;
+using clitest::slurp;
+using clitest::tmpdir;
+using clitest::write;
+int run(const std::string& args) { return clitest::run("wet " + args); }
 }  // namespace
 
 TEST_CASE("cli wet: a small run writes its documented outputs", "[wet][cli]") {
