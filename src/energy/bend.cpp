@@ -7,7 +7,12 @@ double bend_energy(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double lt
     const double la = a.norm(), lb = b.norm();
     const double c = a.dot(b) / (la * lb);
     const double k = 2 / lt0;
-    const double E = k * (1 - c);
+    // 1 - cos phi without cancellation for small angles: (|a||b| - a.b) = (a x b)^2 / (|a||b| + a.b) when a.b > 0.
+    // Exact to round-off (the direct form loses all digits below phi ~ 1e-8 and can turn negative), which the
+    // line searches need near an equilibrium where energy differences are tiny.
+    const double ab = la * lb, dot = a.dot(b), cross = a.x() * b.y() - a.y() * b.x();
+    const double one_minus_c = dot > 0 ? cross * cross / (ab * (ab + dot)) : 1 - c;
+    const double E = k * one_minus_c;
     if (!grad && !hess) return E;
     // dc/da = b/(la lb) - c a/la^2 ; dc/db = a/(la lb) - c b/lb^2.
     const Eigen::Vector2d ca = b / (la * lb) - c * a / (la * la);

@@ -1,4 +1,5 @@
 #include <catch2/catch.hpp>
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "fd.hpp"
@@ -37,4 +38,13 @@ TEST_CASE("bend: small-angle limit is phi^2 / lt0 (seed eq. 4.15)", "[energy]") 
     const double phi = 1e-3, lt0 = 1.3;
     const Eigen::Vector2d d1(1, 0), d2(std::cos(phi), std::sin(phi));
     CHECK(bend_energy(d1, d2, lt0, nullptr, nullptr) == Approx(phi * phi / lt0).epsilon(1e-6));
+}
+
+TEST_CASE("bend: the energy is exact and non-negative at tiny angles", "[energy]") {
+    for (double phi : {1e-12, 1e-9, 1e-6}) {
+        const Eigen::Vector2d d1(3.7, 1.3), d2 = Eigen::Rotation2Dd(phi).toRotationMatrix() * Eigen::Vector2d(0.37, 0.13);
+        const double E = bend_energy(d1, d2, 1.0, nullptr, nullptr);
+        CHECK(E >= 0);
+        CHECK(E == Approx(phi * phi).epsilon(1e-3));  // 2 (1 - cos phi) = phi^2 + O(phi^4); the naive form gives 0 at 1e-12
+    }
 }
