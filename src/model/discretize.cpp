@@ -120,6 +120,11 @@ Model discretize(const Network& net, const DiscretizationParams& p) {
                 if (q.crossing < 0 && std::abs(q.s - pin.s) <= tol) q = {q.s, pin.crossing}, replaced = true;
             if (!replaced) pts.push_back(pin);
         }
+        for (double b : fib.breakpoints) {
+            bool present = false;
+            for (const auto& q : pts) present = present || std::abs(q.s - b * unit) <= tol;
+            if (!present) pts.push_back({b * unit, -1});
+        }
         std::sort(pts.begin(), pts.end(), [](const Pin& a, const Pin& b) { return a.s < b.s; });
         if (p.scheme == Scheme::Even) {
             std::vector<Pin> fine{pts.front()};

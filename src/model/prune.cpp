@@ -85,12 +85,17 @@ Network prune(const Network& net, const PruneOptions& opt, std::vector<int>* kep
             out.fibers.push_back(net.fibers[f]);
             kept.push_back(f);
         }
-    for (const auto& c : net.crossings)
+    for (const auto& c : net.crossings) {
         if (keep[c.f1] && keep[c.f2]) {
             Crossing d = c;
             d.f1 = index[c.f1], d.f2 = index[c.f2];
             out.crossings.push_back(d);
+        } else if (c.crosslink && keep[c.f1] != keep[c.f2]) {
+            // The kept fiber keeps a node where the pruned one was pinned: its discretization stays the same.
+            if (keep[c.f1]) out.fibers[index[c.f1]].breakpoints.push_back(c.s1);
+            else out.fibers[index[c.f2]].breakpoints.push_back(c.s2);
         }
+    }
     if (kept_out) *kept_out = kept;
     return out;
 }

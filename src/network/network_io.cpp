@@ -22,6 +22,13 @@ void write_network(std::ostream& os, const Network& net) {
     for (const auto& c : net.crossings)
         os << c.f1 << ' ' << c.f2 << ' ' << c.s1 << ' ' << c.s2 << ' ' << c.image.x() << ' ' << c.image.y() << ' '
            << (c.crosslink ? 1 : 0) << '\n';
+    size_t nb = 0;
+    for (const auto& f : net.fibers) nb += f.breakpoints.size();
+    if (nb > 0) {
+        os << "breakpoints " << nb << '\n';
+        for (size_t i = 0; i < net.fibers.size(); ++i)
+            for (double s : net.fibers[i].breakpoints) os << i << ' ' << s << '\n';
+    }
 }
 
 namespace {
@@ -166,7 +173,24 @@ Network read_network(std::istream& is, const std::string& source) {
     std::string rest;
     while (std::getline(is, rest)) {
         ++r.line;
-        if (rest.find_first_not_of(" \t\r") != std::string::npos) r.fail("unexpected content after the crossings: '" + rest + "'");
+        const auto p = rest.find_first_not_of(" \t\r");
+        if (p == std::string::npos || rest[p] == '#') continue;
+        std::istringstream bs(rest);
+        std::string kw;
+        bs >> kw;
+        if (kw != "breakpoints") r.fail("unexpected content after the crossings: '" + rest + "'");
+        r.text = rest;
+        const long nb = r.integer(bs, "breakpoint count", 0, 1000000000);
+        r.expect_end(bs);
+        for (long k = 0; k < nb; ++k) {
+            auto ls = r.next("breakpoint " + std::to_string(k));
+            const long f = r.integer(ls, "breakpoint fiber", 0, nf - 1);
+            const double s = r.number(ls, "breakpoint s");
+            if (s < 0 || s > net.fibers[f].length)
+                r.fail("breakpoint s = " + show(s) + " lies outside fiber " + std::to_string(f));
+            r.expect_end(ls);
+            net.fibers[f].breakpoints.push_back(s);
+        }
     }
     return net;
 }

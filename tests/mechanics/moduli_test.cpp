@@ -40,13 +40,14 @@ SolverOptions options() {
 struct Linear {
     double G = 0, K = 0, G_aff = 0;
     bool ok = false;
+    double G_err = 0, K_err = 0;  // the solve's own error bounds
 };
 
 Linear moduli_at(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F) {
     Box box = e.model().box;
     box.F = F;
     const auto m = linear_moduli(e, q, F, {shear_mode(F, box.area()), bulk_mode(F, box.area())});
-    return {m[0].value, m[1].value, m[0].affine, m[0].ok && m[1].ok};
+    return {m[0].value, m[1].value, m[0].affine, m[0].ok && m[1].ok, m[0].error, m[1].error};
 }
 
 }  // namespace
@@ -139,13 +140,11 @@ TEST_CASE("a floppy network (q = 2, below percolation) has G = 0 and K = 0", "[m
     }
 }
 
-// Pruning works on the Network, before discretization: a dropped fiber's crosslink on a kept fiber is no longer a
-// node there, so the kept fiber is split differently and G moves by the discretization error (measured on L = 4,
-// q = 8, pl = 0.9, seed 5, even scheme: 1.1e-4 at h = 1, 1.9e-5 at 0.5, 1.6e-7 at 0.25, 1.2e-9 at 0.125). The
-// mechanics is unchanged: at h = 0.125 (and for seed 3, whose dropped fibers pin nothing that is kept) the results
-// agree to 1e-7 at the reference state.
+// Pruning keeps a node on a kept fiber where a dropped fiber was pinned (Fiber::breakpoints), so the kept fibers are
+// discretized exactly as before and the results agree to solver precision at any h. (Before breakpoints, seed 5
+// at h = 1 differed by 1.1e-4: the discretization error of splitting the kept fiber differently.)
 TEST_CASE("pruning dangling fibers and non-spanning clusters changes neither G nor K", "[moduli][prune]") {
-    for (const auto& [seed, h] : {std::pair<std::uint64_t, double>{3, 1.0}, {5, 0.125}}) {
+    for (const auto& [seed, h] : {std::pair<std::uint64_t, double>{3, 1.0}, {5, 1.0}, {5, 0.5}}) {
         const Model full = make_model(4, 8, 0.9, 10, seed, Scheme::Even, {}, h);
         const Model pruned = make_model(4, 8, 0.9, 10, seed, Scheme::Even, PruneOptions{true, true}, h);
         REQUIRE(pruned.chains.size() < full.chains.size());
@@ -165,8 +164,10 @@ TEST_CASE("pruning dangling fibers and non-spanning clusters changes neither G n
             // At gamma = 0.01 fibers have buckled and the leftover discretization difference shows more (1e-6 to
             // 3e-6 measured, depending on the Newton path): checked at 1e-5 there.
             const double tol = gamma == 0 ? 1e-7 : 1e-5;
-            CHECK(lb.G == Approx(la.G).epsilon(tol));
-            CHECK(lb.K == Approx(la.K).epsilon(tol));
+            // Plus the solves' own error bounds: the unpruned model's floppy dangling fibers slow the conjugate
+            // gradients (seed 5: bound 2.3e-8 against 4.6e-10 pruned, the whole 5.7e-7 relative difference).
+            CHECK(std::abs(lb.G - la.G) <= tol * std::abs(la.G) + la.G_err + lb.G_err);
+            CHECK(std::abs(lb.K - la.K) <= tol * std::abs(la.K) + la.K_err + lb.K_err);
             // Margins: at gamma = 0 both are round-off (~1e-13; the bending term can come out -1e-13).
             CHECK(b.energy == Approx(a.energy).epsilon(1e-7).margin(1e-11));
             CHECK(stress(ep, b.q, F).sigma(0, 1) == Approx(stress(ef, a.q, F).sigma(0, 1)).epsilon(1e-7).margin(1e-11));

@@ -1,6 +1,10 @@
 #include <catch2/catch.hpp>
 
+#include <sstream>
+
+#include "fibernet/model/discretize.hpp"
 #include "fibernet/model/prune.hpp"
+#include "fibernet/network/network_io.hpp"
 #include "fibernet/network/mikado.hpp"
 
 using namespace fibernet;
@@ -40,4 +44,33 @@ TEST_CASE("prune nonspanning: only clusters that wrap the periodic box stay", "[
     // Open boxes never wrap.
     p.q = 8, p.periodic = false;
     for (char c : wrapping_fibers(generate_mikado(p))) CHECK(c == 0);
+}
+
+TEST_CASE("prune: kept fibers are discretized exactly as in the unpruned model", "[model][prune]") {
+    MikadoParams p;
+    p.L = 5, p.q = 8, p.pl = 0.8, p.seed = 6;
+    const Network net = generate_mikado(p);
+    std::vector<int> kept;
+    const Network pr = prune(net, {true, true}, &kept);
+    REQUIRE(!pr.fibers.empty());
+    REQUIRE(pr.fibers.size() < net.fibers.size());
+    int with_breakpoints = 0;
+    for (const auto& f : pr.fibers) with_breakpoints += !f.breakpoints.empty();
+    REQUIRE(with_breakpoints > 0);  // some kept fiber lost a crosslink partner
+    for (Scheme s : {Scheme::Seed, Scheme::Even}) {
+        DiscretizationParams d;
+        d.scheme = s;
+        const Model full = discretize(net, d), part = discretize(pr, d);
+        for (size_t i = 0; i < kept.size(); ++i) {
+            const auto& a = full.chains[kept[i]].s;
+            const auto& b = part.chains[i].s;
+            REQUIRE(a.size() == b.size());
+            for (size_t k = 0; k < a.size(); ++k) CHECK(b[k] == Approx(a[k]).margin(1e-12));
+        }
+    }
+    // Breakpoints survive a save and load.
+    std::stringstream ss;
+    write_network(ss, pr);
+    const Network back = read_network(ss, "memory");
+    for (size_t i = 0; i < pr.fibers.size(); ++i) CHECK(back.fibers[i].breakpoints == pr.fibers[i].breakpoints);
 }

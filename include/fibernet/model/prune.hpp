@@ -17,7 +17,9 @@ struct PruneOptions {
     bool nonspanning = false;
 };
 
-// Returns the pruned network; kept[i] is the original index of fiber i of the result.
+// Returns the pruned network; kept[i] is the original index of fiber i of the result. Where a pruned fiber was
+// pinned to a kept one, the kept fiber gets a breakpoint there, so its nodes and segments are exactly those of the
+// unpruned model and results agree to solver precision, not just to discretization error.
 Network prune(const Network& net, const PruneOptions& opt, std::vector<int>* kept = nullptr);
 
 // True per fiber if its crosslink cluster wraps around the periodic box (false for every fiber in an open box).

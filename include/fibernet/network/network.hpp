@@ -12,6 +12,9 @@ struct Fiber {
     Eigen::Vector2d start;  // one end, unwrapped; the fiber runs start -> start + length * direction()
     double theta = 0;       // orientation in [0, pi)
     double length = 1;
+    // Extra node positions (arc, fiber lengths) the discretization must keep: where pruned fibers were pinned to
+    // this one, so that pruning leaves the discretization of every kept fiber unchanged (model/prune.hpp).
+    std::vector<double> breakpoints;
 
     Eigen::Vector2d direction() const { return {std::cos(theta), std::sin(theta)}; }
     Eigen::Vector2d point(double s) const { return start + s * direction(); }
