@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 2 figures: model sizes for both schemes at L=10, q=8, pl=1, and generation time for 1e5 fibers.
+# Issue 2 figures: model sizes for both schemes at L=10, q=8, pl=1, and generation time for 1e5 and 1e6 fibers.
 # Usage: bench/network_figures.sh [build-dir]   (prints a Markdown table)
 set -euo pipefail
 exe=${1:-build}/fibernet
@@ -13,12 +13,14 @@ done
 echo
 echo "| fibers (q=8) | generation seconds (best of 3) | crossings per fiber (2q/pi = 5.093) |"
 echo "|---|---|---|"
-L=$(python3 -c "print((1e5/8)**0.5)")
-best=1e9; cpf=0
-for s in 1 2 3; do
-  line=$("$exe" generate --L "$L" --q 8 --pl 1 --seed "$s" -o /dev/null 2>&1 >/dev/null | tail -1)
-  t=$(python3 -c "import json,sys; print(json.loads(sys.argv[1])['generation_seconds'])" "$line")
-  cpf=$(python3 -c "import json,sys; print(json.loads(sys.argv[1])['crossings_per_fiber'])" "$line")
-  best=$(python3 -c "print(min($best, $t))")
+for N in 100000 1000000; do
+  L=$(python3 -c "print(($N/8)**0.5)")
+  best=1e9; cpf=0
+  for s in 1 2 3; do
+    line=$("$exe" generate --L "$L" --q 8 --pl 1 --seed "$s" -o /dev/null 2>&1 >/dev/null | tail -1)
+    t=$(python3 -c "import json,sys; print(json.loads(sys.argv[1])['generation_seconds'])" "$line")
+    cpf=$(python3 -c "import json,sys; print(json.loads(sys.argv[1])['crossings_per_fiber'])" "$line")
+    best=$(python3 -c "print(round(min($best, $t), 3))")
+  done
+  echo "| $N | $best | $cpf |"
 done
-echo "| 100000 | $best | $cpf |"

@@ -49,10 +49,12 @@ void sort_crossings(std::vector<Crossing>& c) {
     });
 }
 
-// Adds the crossing of fibers i < j, with j shifted by `image` boxes, if they intersect.
-void try_pair(const Network& net, int i, int j, const Eigen::Vector2i& image, std::vector<Crossing>& out) {
+// Adds the crossing of fibers i < j, with j shifted by `image` boxes, if they intersect. u: unit directions.
+void try_pair(const Network& net, const std::vector<Eigen::Vector2d>& u, int i, int j, const Eigen::Vector2i& image,
+              std::vector<Crossing>& out) {
     double si, sj;
-    if (intersect(net.fibers[i], net.fibers[j], net.L * image.cast<double>(), si, sj)) {
+    const Fiber &a = net.fibers[i], &b = net.fibers[j];
+    if (intersect(a.start, u[i], a.length, b.start + net.L * image.cast<double>(), u[j], b.length, si, sj)) {
         Crossing c;
         c.f1 = i, c.f2 = j, c.s1 = si, c.s2 = sj, c.image = image;
         out.push_back(c);
@@ -64,13 +66,16 @@ std::vector<Crossing> find_crossings(const Network& net) {
     std::vector<Crossing> out;
     const int n = static_cast<int>(net.fibers.size());
     if (n == 0) return out;
+    // Directions and centres once (cos/sin per fiber, not per candidate pair).
+    std::vector<Eigen::Vector2d> u(n), centre(n);
+    for (int i = 0; i < n; ++i) u[i] = net.fibers[i].direction(), centre[i] = net.fibers[i].start + 0.5 * net.fibers[i].length * u[i];
     double lmax = 0;
     for (const auto& f : net.fibers) lmax = std::max(lmax, f.length);
     // Two fibers can cross only if their centres are within lmax: bin centres in cells of side >= lmax.
     // Open boxes: centres may lie outside [0, L) for hand-made networks, so bin over their bounding box.
     Eigen::Vector2d lo(0, 0), hi(net.L, net.L);
     if (!net.periodic)
-        for (const auto& f : net.fibers) lo = lo.cwiseMin(f.center()), hi = hi.cwiseMax(f.center());
+        for (const auto& c : centre) lo = lo.cwiseMin(c), hi = hi.cwiseMax(c);
     const Eigen::Vector2d ext = hi - lo;
     const int nx = std::max(1, static_cast<int>(std::floor(ext.x() / lmax)));
     const int ny = std::max(1, static_cast<int>(std::floor(ext.y() / lmax)));
@@ -84,7 +89,7 @@ std::vector<Crossing> find_crossings(const Network& net) {
     std::vector<int> cell(n), start(static_cast<size_t>(nx) * ny + 1, 0), order(n);
     for (int i = 0; i < n; ++i) {
         int cx, cy;
-        cell_of(net.fibers[i].center(), cx, cy);
+        cell_of(centre[i], cx, cy);
         cell[i] = cy * nx + cx;
         ++start[cell[i] + 1];
     }
@@ -94,7 +99,9 @@ std::vector<Crossing> find_crossings(const Network& net) {
         for (int i = 0; i < n; ++i) order[fill[cell[i]]++] = i;
     }
     std::vector<int> neighbours;
-    for (int i = 0; i < n; ++i) {
+    // Fibers in cell order: consecutive fibers share their neighbour cells, whose data then stay in cache.
+    for (int k0 = 0; k0 < n; ++k0) {
+        const int i = order[k0];
         const int cx = cell[i] % nx, cy = cell[i] / nx;
         neighbours.clear();
         for (int dy = -1; dy <= 1; ++dy)
@@ -109,7 +116,7 @@ std::vector<Crossing> find_crossings(const Network& net) {
             }
         std::sort(neighbours.begin(), neighbours.end());
         neighbours.erase(std::unique(neighbours.begin(), neighbours.end()), neighbours.end());
-        const Eigen::Vector2d ci = net.fibers[i].center();
+        const Eigen::Vector2d ci = centre[i];
         for (int c : neighbours)
             for (int k = start[c]; k < start[c + 1]; ++k) {
                 const int j = order[k];
@@ -117,11 +124,11 @@ std::vector<Crossing> find_crossings(const Network& net) {
                 Eigen::Vector2i image(0, 0);
                 if (net.periodic) {
                     // L > 2 lmax makes the crossing image unique: the nearest image of j's centre.
-                    const Eigen::Vector2d dc = net.fibers[j].center() - ci;
+                    const Eigen::Vector2d dc = centre[j] - ci;
                     image = Eigen::Vector2i(static_cast<int>(-std::round(dc.x() / net.L)),
                                             static_cast<int>(-std::round(dc.y() / net.L)));
                 }
-                try_pair(net, i, j, image, out);
+                try_pair(net, u, i, j, image, out);
             }
     }
     sort_crossings(out);
@@ -132,10 +139,12 @@ std::vector<Crossing> find_crossings_brute_force(const Network& net) {
     std::vector<Crossing> out;
     const int n = static_cast<int>(net.fibers.size());
     const int r = net.periodic ? 2 : 0;
+    std::vector<Eigen::Vector2d> u(n);
+    for (int i = 0; i < n; ++i) u[i] = net.fibers[i].direction();
     for (int i = 0; i < n; ++i)
         for (int j = i + 1; j < n; ++j)
             for (int my = -r; my <= r; ++my)
-                for (int mx = -r; mx <= r; ++mx) try_pair(net, i, j, Eigen::Vector2i(mx, my), out);
+                for (int mx = -r; mx <= r; ++mx) try_pair(net, u, i, j, Eigen::Vector2i(mx, my), out);
     sort_crossings(out);
     return out;
 }

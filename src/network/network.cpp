@@ -11,14 +11,18 @@ int Network::num_crosslinks() const {
     return n;
 }
 
-bool intersect(const Fiber& a, const Fiber& b, const Eigen::Vector2d& shift, double& sa, double& sb) {
-    const Eigen::Vector2d ua = a.direction(), ub = b.direction();
+bool intersect(const Eigen::Vector2d& a0, const Eigen::Vector2d& ua, double la, const Eigen::Vector2d& b0,
+               const Eigen::Vector2d& ub, double lb, double& sa, double& sb) {
     const double denom = ua.x() * ub.y() - ua.y() * ub.x();
     if (std::abs(denom) < 1e-14) return false;  // parallel fibers never cross (measure zero)
-    const Eigen::Vector2d r = b.start + shift - a.start;
+    const Eigen::Vector2d r = b0 - a0;
     sa = (r.x() * ub.y() - r.y() * ub.x()) / denom;
     sb = (r.x() * ua.y() - r.y() * ua.x()) / denom;
-    return sa >= 0 && sa <= a.length && sb >= 0 && sb <= b.length;
+    return sa >= 0 && sa <= la && sb >= 0 && sb <= lb;
+}
+
+bool intersect(const Fiber& a, const Fiber& b, const Eigen::Vector2d& shift, double& sa, double& sb) {
+    return intersect(a.start, a.direction(), a.length, b.start + shift, b.direction(), b.length, sa, sb);
 }
 
 namespace {

@@ -43,6 +43,9 @@ struct Network {
 
 // Crossing of fiber a with fiber b shifted by `shift`; true and the arc positions if the segments intersect.
 bool intersect(const Fiber& a, const Fiber& b, const Eigen::Vector2d& shift, double& sa, double& sb);
+// The same with the fibers given by start, unit direction and length (directions precomputed in hot loops).
+bool intersect(const Eigen::Vector2d& a0, const Eigen::Vector2d& ua, double la, const Eigen::Vector2d& b0,
+               const Eigen::Vector2d& ub, double lb, double& sa, double& sb);
 
 struct NetworkStats {
     int fibers = 0, crossings = 0, crosslinks = 0;
