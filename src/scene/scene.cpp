@@ -64,6 +64,13 @@ struct TableReader {
         }
         throw InputError(where + "." + key + " has the wrong type (" + type_name(n->type()) + ")");
     }
+    // A random seed: a non-negative TOML integer.
+    void get_seed(const std::string& key, std::uint64_t& out) {
+        int64_t v = 0;
+        if (!get(key, v)) return;
+        if (v < 0) throw InputError(where + "." + key + " = " + std::to_string(v) + " must be >= 0");
+        out = static_cast<std::uint64_t>(v);
+    }
     void finish() const {
         for (const auto& [k, v] : t)
             if (!known.count(std::string(k.str())))
@@ -99,11 +106,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         r.get("L", s.mikado.L);
         r.get("q", s.mikado.q);
         r.get("pl", s.mikado.pl);
-        int64_t seed = static_cast<int64_t>(s.mikado.seed);
-        if (r.get("seed", seed)) {
-            if (seed < 0) throw InputError(source + ": [network].seed = " + std::to_string(seed) + " must be >= 0");
-            s.mikado.seed = static_cast<std::uint64_t>(seed);
-        }
+        r.get_seed("seed", s.mikado.seed);
         r.get("periodic", s.mikado.periodic);
         r.get("file", s.network_file);
         r.finish();
@@ -161,11 +164,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         r.get("law", s.wet.law);
         r.get("crossings", s.wet.crossings);
         r.get("fraction", s.wet.fraction);
-        int64_t seed = static_cast<int64_t>(s.wet.seed);
-        if (r.get("seed", seed)) {
-            if (seed < 0) throw InputError(source + ": [wet].seed = " + std::to_string(seed) + " must be >= 0");
-            s.wet.seed = static_cast<std::uint64_t>(seed);
-        }
+        r.get_seed("seed", s.wet.seed);
         r.finish();
     }
     s.check();

@@ -37,5 +37,6 @@ TEST_CASE("scene: bad scenes name the file, key and value", "[scene][input]") {
     CHECK_THROWS_WITH(parse_scene("[model]\nscheme = \"odd\"\n", "s.toml"), Catch::Contains("'odd'"));
     CHECK_THROWS_WITH(parse_scene("[model]\nn_seg = 0\n", "s.toml"), Catch::Contains("n_seg = 0"));
     CHECK_THROWS_WITH(parse_scene("[network\n", "s.toml"), Catch::Contains("s.toml:1"));
+    CHECK_THROWS_WITH(parse_scene("[network]\nseed = -4\n", "s.toml"), Catch::Contains("[network].seed = -4 must be >= 0"));
     CHECK_THROWS_AS(load_scene("/nonexistent.toml"), InputError);
 }
