@@ -87,6 +87,18 @@ NetworkEnergy::NetworkEnergy(const Model& model, EnergyParams params) : model_(m
                                                             outer.data(), inner.data(), zeros.data());
     pattern_.makeCompressed();
 
+    // Rest vectors: exact ones from the discretization, else from the reference positions.
+    const Eigen::Matrix2d B0 = model.box.B0();
+    auto rest = [&](const Eigen::Vector2d& given, int i, int j, const Eigen::Vector2i& n) -> Eigen::Vector2d {
+        if (given.allFinite()) return given;
+        return model.x.segment<2>(2 * j) - model.x.segment<2>(2 * i) + B0 * n.cast<double>();
+    };
+    for (const auto& s : model.segments) seg_d0_.push_back(rest(s.d0, s.i, s.j, s.shift));
+    for (const auto& h : model.hinges) {
+        hinge_d0_.push_back(rest(h.d10, h.i, h.j, h.shift1));
+        hinge_d0_.push_back(rest(h.d20, h.j, h.k, h.shift2));
+    }
+
     seg_slots_.resize(n_upper<4>() * model.segments.size());
     for (size_t e = 0; e < model.segments.size(); ++e) {
         const int nodes[2] = {model.segments[e].i, model.segments[e].j};
@@ -102,7 +114,7 @@ NetworkEnergy::NetworkEnergy(const Model& model, EnergyParams params) : model_(m
 Eigen::VectorXd NetworkEnergy::dofs(const Eigen::VectorXd& x) const {
     Eigen::VectorXd q(ndof_);
     for (size_t k = 0; k < dof_.size(); ++k)
-        if (dof_[k] >= 0) q[dof_[k]] = x[k];
+        if (dof_[k] >= 0) q[dof_[k]] = x[k] - model_.x[k];
     return q;
 }
 
@@ -110,7 +122,7 @@ Eigen::VectorXd NetworkEnergy::positions(const Eigen::VectorXd& q, const Eigen::
     Eigen::VectorXd x(dof_.size());
     for (int i = 0; i < model_.num_nodes(); ++i) {
         if (dof_[2 * i] >= 0) {
-            x[2 * i] = q[dof_[2 * i]], x[2 * i + 1] = q[dof_[2 * i + 1]];
+            x[2 * i] = model_.x[2 * i] + q[dof_[2 * i]], x[2 * i + 1] = model_.x[2 * i + 1] + q[dof_[2 * i + 1]];
         } else {
             x.segment<2>(2 * i) = F * model_.x.segment<2>(2 * i);
         }
@@ -129,8 +141,14 @@ Eigen::VectorXd NetworkEnergy::affine_map(const Eigen::VectorXd& q, const Eigen:
 void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F, const Eigen::Matrix2d& dF,
                              unsigned want, EnergyEval& out, Eigen::SparseMatrix<double>* H) const {
     const bool wg = want & kGradient, wh = want & kHessian, ws = want & kStrain, psd = want & kProjectPSD;
-    const Eigen::VectorXd x = positions(q, F);
-    const Eigen::Matrix2d B = F * model_.box.B0(), dB = dF * model_.box.B0();
+    // Node displacements u = x - x_ref: q for free nodes, (F - I) x_ref for fixed ones.
+    Eigen::VectorXd u(dof_.size());
+    const Eigen::Matrix2d FmI = F - Eigen::Matrix2d::Identity();
+    for (int i = 0; i < model_.num_nodes(); ++i) {
+        if (dof_[2 * i] >= 0) u[2 * i] = q[dof_[2 * i]], u[2 * i + 1] = q[dof_[2 * i + 1]];
+        else u.segment<2>(2 * i) = FmI * model_.x.segment<2>(2 * i);
+    }
+    const Eigen::Matrix2d dB = dF * model_.box.B0(), FmIB0 = FmI * model_.box.B0();
     const double k4a2 = 4 * model_.aspect_ratio * model_.aspect_ratio;
     const bool any_fixed = ndof_ != static_cast<int>(dof_.size());
     out.energy = out.stretch = out.bend = 0;
@@ -147,9 +165,11 @@ void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
         const int d0 = dof_[2 * node];
         if (d0 >= 0) v[d0] += g.x(), v[d0 + 1] += g.y();
     };
-    // Edge vector and its strain rate dd/dt = dF (B0 n + [fixed] x_ref differences).
-    auto edge = [&](int i, int j, const Eigen::Vector2i& n, Eigen::Vector2d& d, Eigen::Vector2d& c) {
-        d = x.segment<2>(2 * j) - x.segment<2>(2 * i) + B * n.cast<double>();
+    // Edge vector d = d0 + (F - I) B0 n + u_j - u_i (= x_j - x_i + F B0 n) and its strain rate
+    // dd/dt = dF (B0 n + [fixed] x_ref differences).
+    auto edge = [&](int i, int j, const Eigen::Vector2i& n, const Eigen::Vector2d& d0, Eigen::Vector2d& d,
+                    Eigen::Vector2d& c) {
+        d = d0 + FmIB0 * n.cast<double>() + (u.segment<2>(2 * j) - u.segment<2>(2 * i));
         if (!ws) return;
         c = dB * n.cast<double>();
         if (any_fixed) {
@@ -162,7 +182,7 @@ void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
     Eigen::Matrix2d Hd;
     for (size_t e = 0; e < model_.segments.size(); ++e) {
         const Segment& s = model_.segments[e];
-        edge(s.i, s.j, s.shift, d, c);
+        edge(s.i, s.j, s.shift, seg_d0_[e], d, c);
         const double E = stretch_energy(d, s.l0, k4a2, params_.stretch, (wg || ws) ? &gd : nullptr,
                                         (wh || ws) ? &Hd : nullptr);
         out.stretch += E;
@@ -191,8 +211,8 @@ void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
     A.block<2, 2>(2, 4) = Eigen::Matrix2d::Identity();
     for (size_t e = 0; e < model_.hinges.size(); ++e) {
         const Hinge& h = model_.hinges[e];
-        edge(h.i, h.j, h.shift1, d1, c1);
-        edge(h.j, h.k, h.shift2, d2, c2);
+        edge(h.i, h.j, h.shift1, hinge_d0_[2 * e], d1, c1);
+        edge(h.j, h.k, h.shift2, hinge_d0_[2 * e + 1], d2, c2);
         const double E = bend_energy(d1, d2, h.lt0, (wg || ws) ? &g4 : nullptr, (wh || ws) ? &H4 : nullptr);
         out.bend += E;
         if (wg) {

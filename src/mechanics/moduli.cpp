@@ -57,7 +57,7 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
 
     // Affine predictions: d2E/dt2 along the affine path x(t) = F(t) x_ref with no relaxation: at the affinely deformed
     // reference q_a, E_tt + 2 v.E_xt + v.H v with v = dF F^{-1} x the affine velocity (one more assembly). This is
-    // not the fixed-q E_tt above, which with absolute coordinates holds only the terms of box-crossing segments.
+    // not the fixed-q E_tt above, which (q fixed = positions fixed) holds only the terms of box-crossing segments.
     t0 = Clock::now();
     const Eigen::VectorXd qa = n > 0 ? affine_start(e, F) : Eigen::VectorXd();
     // At the affine state itself (the straight reference at F = I is one), the comoving E_tt below is already the
@@ -70,7 +70,9 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
             e.evaluate(qa, F, modes[m].dF, kStrain | (m == 0 ? kHessian : 0u), ev, m == 0 ? &Ha : nullptr);
             const Eigen::Matrix2d V = modes[m].dF * Finv_a;
             Eigen::VectorXd v(n);
-            for (int i = 0; i < n / 2; ++i) v.segment<2>(2 * i) = V * qa.segment<2>(2 * i);
+            const Eigen::VectorXd xa = e.positions(qa, F);  // q are displacements: the velocity needs positions
+            for (int i = 0; i < e.model().num_nodes(); ++i)
+                if (e.dof(i, 0) >= 0) v.segment<2>(e.dof(i, 0)) = V * xa.segment<2>(2 * i);
             const Eigen::VectorXd Hv = Ha.selfadjointView<Eigen::Upper>() * v;
             out[m].affine = modes[m].scale * (ev.d2E_dt2 + 2 * v.dot(ev.d2E_dqdt) + v.dot(Hv));
         }
@@ -113,6 +115,7 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
     t0 = Clock::now();
     const auto Hs = H.selfadjointView<Eigen::Upper>();
     const Eigen::Matrix2d Finv = F.inverse();
+    const Eigen::VectorXd x = e.positions(q, F);  // absolute positions: the affine velocity is dF F^-1 x
     const int M = static_cast<int>(modes.size());
     Eigen::MatrixXd B(n, M), V(n, M);
     for (int m = 0; m < M; ++m) {
@@ -122,7 +125,8 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
         // coordinates, where box-crossing segments make E_tt ~ 1e8 and the cancellation costs 6 digits.
         const Eigen::Matrix2d Vm = modes[m].dF * Finv;
         Eigen::VectorXd v(n);
-        for (int i = 0; i < n / 2; ++i) v.segment<2>(2 * i) = Vm * q.segment<2>(2 * i);
+        for (int i = 0; i < e.model().num_nodes(); ++i)
+            if (e.dof(i, 0) >= 0) v.segment<2>(e.dof(i, 0)) = Vm * x.segment<2>(2 * i);
         const Eigen::VectorXd Hv = Hs * v;
         out[m].E_tt += 2 * v.dot(b[m]) + v.dot(Hv);
         B.col(m) = b[m] + Hv;

@@ -165,6 +165,7 @@ Model discretize(const Network& net, const DiscretizationParams& p) {
             sg.i = ch.nodes[k], sg.j = ch.nodes[k + 1];
             sg.shift = wraps[k + 1] - wraps[k];
             sg.l0 = ch.s[k + 1] - ch.s[k];
+            sg.d0 = sg.l0 * u;  // exact rest vector: no cancellation of large wrapped coordinates
             sg.fiber = f;
             ch.segments.push_back(static_cast<int>(m.segments.size()));
             m.segments.push_back(sg);
@@ -176,6 +177,7 @@ Model discretize(const Network& net, const DiscretizationParams& p) {
             hg.i = a.i, hg.j = a.j, hg.k = b.j;
             hg.shift1 = a.shift, hg.shift2 = b.shift;
             hg.lt0 = 0.5 * (a.l0 + b.l0);
+            hg.d10 = a.d0, hg.d20 = b.d0;
             hg.fiber = f;
             m.hinges.push_back(hg);
         }

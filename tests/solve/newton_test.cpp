@@ -222,8 +222,8 @@ TEST_CASE("newton: a collapsed start is reported as non-finite, not hidden", "[n
     const Model m = discretize(generate_mikado(mp), dp);
     NetworkEnergy e(m);
     StrainedEnergy obj(e, Eigen::Matrix2d::Identity());
-    Eigen::VectorXd q = e.dofs(m.x);
-    q.setZero();  // every node at the origin: collapsed segments, energy +inf
+    // Every node at the origin: collapsed segments, energy +inf.
+    Eigen::VectorXd q = e.dofs(Eigen::VectorXd::Zero(m.x.size()));
     NewtonSolver newton(SolverOptions{});
     const SolveResult r = newton.minimize(obj, q);
     CHECK(r.status == SolveStatus::NonFinite);

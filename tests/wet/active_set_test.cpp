@@ -57,12 +57,13 @@ TEST_CASE("active set: a bridge dragged across a kinked node moves without an en
     const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.25, 1.5, 60, 1, 0.45}}, 3);
     const Model m = model_of(net);
     NetworkEnergy e(m);
-    Eigen::VectorXd q = e.dofs(m.x);
+    Eigen::VectorXd pos = m.x;
     const double kink = 15 * M_PI / 180;
     for (int n : m.chains[0].nodes) {
-        const double x = q[e.dof(n, 0)] - 13, y = q[e.dof(n, 1)] - 15;
-        if (x > 1e-9) q[e.dof(n, 0)] = 13 + std::cos(kink) * x - std::sin(kink) * y, q[e.dof(n, 1)] = 15 + std::sin(kink) * x + std::cos(kink) * y;
+        const double x = pos[2 * n] - 13, y = pos[2 * n + 1] - 15;
+        if (x > 1e-9) pos[2 * n] = 13 + std::cos(kink) * x - std::sin(kink) * y, pos[2 * n + 1] = 15 + std::sin(kink) * x + std::cos(kink) * y;
     }
+    Eigen::VectorXd q = e.dofs(pos);
     std::vector<Bridge> bridges = wet_crossings(net, m, e.positions(q, I2), m.box.B0(), {});
     REQUIRE(bridges.size() == 1);
     CHECK(bridges[0].k1 == 2);

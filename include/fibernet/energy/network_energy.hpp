@@ -3,7 +3,10 @@
 // assembled into a global gradient and a sparse Hessian over the free coordinates q, together with the
 // derivatives with respect to a strain parameter t along F(t) = F + t dF (DESIGN.md §2).
 //
-// Node positions: a free node's coordinates come from q; a fixed node (clamp) sits at F x_ref.
+// Coordinates: q holds the free nodes' displacements from their reference positions, x = x_ref + q; a fixed node
+// (clamp) sits at F x_ref. Segment vectors are formed as d = d0 + (F - I) B0 n + (u_j - u_i) from the exact rest
+// vector d0, so no large wrapped coordinates (~L) are subtracted: the gradient's round-off floor is set by the
+// displacements (~1), not by the box size (~100-1000). Derivatives with respect to q equal those with respect to x.
 // The Hessian's upper-triangular pattern is built once per model; evaluate() refills the values.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -42,7 +45,7 @@ public:
 
     const Model& model() const { return model_; }
     int num_dofs() const { return ndof_; }
-    // Free coordinates of a node-position vector (2 per node), and back (fixed nodes at F x_ref).
+    // Free coordinates (displacements) of a node-position vector (2 per node), and back (fixed nodes at F x_ref).
     Eigen::VectorXd dofs(const Eigen::VectorXd& x) const;
     Eigen::VectorXd positions(const Eigen::VectorXd& q, const Eigen::Matrix2d& F) const;
     // Index of coordinate c of node i in q, or -1 if fixed.
@@ -65,6 +68,8 @@ private:
     Eigen::SparseMatrix<double> pattern_;  // upper triangle
     std::vector<int> seg_slots_;           // 10 per segment: value index of local upper entry (a<=b) or -1
     std::vector<int> hinge_slots_;         // 21 per hinge
+    std::vector<Eigen::Vector2d> seg_d0_;  // rest vectors per segment
+    std::vector<Eigen::Vector2d> hinge_d0_;  // 2 per hinge
 };
 
 // The energy at a fixed deformation F, as a solver sees it.

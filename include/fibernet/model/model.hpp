@@ -3,6 +3,7 @@
 // hinges at interior nodes, crosslinks as shared supernodes (free pins: no bending couples two fibers).
 // Lengths in seed units: ls = lf / 10, so a fiber has length `fiber_length` = 10 unless a scene says otherwise.
 #include <Eigen/Core>
+#include <cmath>
 #include <vector>
 
 #include "fibernet/box/box.hpp"
@@ -14,6 +15,8 @@ struct Segment {
     Eigen::Vector2i shift{0, 0};
     double l0 = 0;              // rest length
     int fiber = 0;
+    // Rest vector (length l0 along the straight fiber). NaN: derive it from the reference positions.
+    Eigen::Vector2d d0{NAN, NAN};
 };
 
 struct Hinge {
@@ -21,6 +24,7 @@ struct Hinge {
     Eigen::Vector2i shift1{0, 0}, shift2{0, 0};
     double lt0 = 0;             // rest effective length (l0_left + l0_right) / 2 (seed eq. 4.9)
     int fiber = 0;
+    Eigen::Vector2d d10{NAN, NAN}, d20{NAN, NAN};  // rest vectors of the two segments (NaN: from positions)
 };
 
 struct Supernode {
