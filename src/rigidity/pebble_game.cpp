@@ -78,13 +78,7 @@ void PebbleGame::condense_visited() {
     outdeg_[z] = 0;
 }
 
-bool PebbleGame::add_bar(int a, int b) {
-    if (a == b) throw std::invalid_argument("pebble game: a bar needs two different bodies (got " + std::to_string(a) + ")");
-    const int ra = root(a), rb = root(b);
-    if (ra == rb) {
-        ++redundant_;
-        return false;
-    }
+bool PebbleGame::gather_four(int ra, int rb) {
     while (pebbles(ra) + pebbles(rb) < 4) {
         if (++stamp_ == 0) std::fill(mark_.begin(), mark_.end(), 0), stamp_ = 1;
         mark_[ra] = mark_[rb] = stamp_;
@@ -92,9 +86,18 @@ bool PebbleGame::add_bar(int a, int b) {
         const bool got = (pebbles(ra) < 3 && search(ra)) || (pebbles(rb) < 3 && search(rb));
         if (!got) {
             condense_visited();
-            ++redundant_;
             return false;
         }
+    }
+    return true;
+}
+
+bool PebbleGame::add_bar(int a, int b) {
+    if (a == b) throw std::invalid_argument("pebble game: a bar needs two different bodies (got " + std::to_string(a) + ")");
+    const int ra = root(a), rb = root(b);
+    if (ra == rb || !gather_four(ra, rb)) {
+        ++redundant_;
+        return false;
     }
     const int tail = pebbles(ra) > 0 ? ra : rb;
     out_[3 * tail + outdeg_[tail]++] = tail == ra ? rb : ra;
@@ -104,18 +107,7 @@ bool PebbleGame::add_bar(int a, int b) {
 
 bool PebbleGame::rigidly_connected(int a, int b) {
     const int ra = root(a), rb = root(b);
-    if (ra == rb) return true;
-    while (pebbles(ra) + pebbles(rb) < 4) {
-        if (++stamp_ == 0) std::fill(mark_.begin(), mark_.end(), 0), stamp_ = 1;
-        mark_[ra] = mark_[rb] = stamp_;
-        visited_.assign({ra, rb});
-        const bool got = (pebbles(ra) < 3 && search(ra)) || (pebbles(rb) < 3 && search(rb));
-        if (!got) {
-            condense_visited();
-            return true;
-        }
-    }
-    return false;
+    return ra == rb || !gather_four(ra, rb);
 }
 
 int PebbleGame::gatherable_on_pair(int a, int b) {

@@ -157,9 +157,7 @@ SolveResult IpoptSolver::minimize(Objective& f_in, Eigen::VectorXd& q) {
     auto finish = [&](SolveStatus st, const std::string& msg) {
         r.energy = f.gradient(q, g);  // the returned state, evaluated afresh
         r.grad_max = detail::max_abs(g);
-        if (!std::isfinite(r.energy) || !g.allFinite()) st = SolveStatus::NonFinite;
-        else if (r.grad_max <= opt_.tol) st = SolveStatus::Converged;
-        else if (st == SolveStatus::Converged) st = SolveStatus::Stalled;
+        st = detail::verified_status(st, r.energy, g, opt_.tol, SolveStatus::Stalled);
         r.status = st, r.message = msg, r.evaluations = f.evals;
         r.timings.total = clock.seconds();
         progress.done(clock, to_string(st), r.iterations, r.energy, r.grad_max);

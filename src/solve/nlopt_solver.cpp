@@ -106,10 +106,7 @@ SolveResult NloptSolver::minimize(Objective& f_in, Eigen::VectorXd& q) {
         // Report the state we return, evaluated afresh: never NLopt's word for it.
         r.energy = f.gradient(q, g);
         r.grad_max = detail::max_abs(g);
-        const bool finite = std::isfinite(r.energy) && g.allFinite();
-        if (!finite) st = SolveStatus::NonFinite;
-        else if (st != SolveStatus::Converged && r.grad_max <= opt_.tol) st = SolveStatus::Converged;
-        else if (st == SolveStatus::Converged && r.grad_max > opt_.tol) st = SolveStatus::Failed;
+        st = detail::verified_status(st, r.energy, g, opt_.tol, SolveStatus::Failed);
         r.status = st, r.message = msg, r.evaluations = f.evals;
         r.iterations = f.evals;  // NLopt reports no iteration count
         r.timings.total = clock.seconds();

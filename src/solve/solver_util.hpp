@@ -24,6 +24,15 @@ inline double max_abs(const Eigen::VectorXd& v) { return v.size() ? v.lpNorm<Eig
 
 inline bool all_finite(const Eigen::VectorXd& v) { return v.allFinite(); }
 
+// Status of a returned state evaluated afresh, never the backend's word for it: NonFinite if the energy or gradient
+// is; Converged exactly when max|g| <= tol; a backend that claimed convergence above tol gets `claimed_above_tol`.
+inline SolveStatus verified_status(SolveStatus claimed, double energy, const Eigen::VectorXd& g, double tol,
+                                   SolveStatus claimed_above_tol) {
+    if (!std::isfinite(energy) || !g.allFinite()) return SolveStatus::NonFinite;
+    if (max_abs(g) <= tol) return SolveStatus::Converged;
+    return claimed == SolveStatus::Converged ? claimed_above_tol : claimed;
+}
+
 class Clock {
 public:
     Clock() : t0_(std::chrono::steady_clock::now()) {}

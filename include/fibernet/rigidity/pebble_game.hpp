@@ -44,6 +44,9 @@ private:
     int pebbles(int r) const { return 3 - outdeg_[r]; }
     // Searches from root r for a free pebble on a root other than the blocked ones; moves it to r.
     bool search(int r);
+    // Gathers 4 free pebbles on roots ra != rb; false (after condensing the failed search's region into one rigid
+    // body) when it cannot: then ra and rb are rigidly connected.
+    bool gather_four(int ra, int rb);
     void condense_visited();
 
     std::vector<int> parent_;
