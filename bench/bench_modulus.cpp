@@ -6,7 +6,8 @@
 // 3); t_analyze: the symbolic analysis (once per model); t_modulus: linear_moduli (G and K: assembly, analysis,
 // one factorization, refinement solves) at the reference equilibrium; ratio = t_modulus / t_factor; newton_s: the
 // equilibrium at gamma = 0.01 to max|g| <= 1e-10 (or the round-off floor), linear-response start included.
-// Usage: bench_modulus L scheme [gamma]      (gamma = 0 skips the strained equilibrium)      (bench/run_modulus_bench.sh runs the table of docs/benchmarks.md)
+// Usage: bench_modulus L scheme [gamma] [prune]   (gamma = 0 skips the strained equilibrium; prune = none |
+//        ends | dangling,ends: the model-reduction rules of docs/moduli.md, "Pruning")      (bench/run_modulus_bench.sh runs the table of docs/benchmarks.md)
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include "fibernet/mechanics/equilibrium.hpp"
 #include "fibernet/mechanics/moduli.hpp"
 #include "fibernet/model/discretize.hpp"
+#include "fibernet/model/prune.hpp"
 #include "fibernet/network/mikado.hpp"
 #include "fibernet/solve/cholmod_llt.hpp"
 #include "fibernet/solve/newton.hpp"
@@ -30,7 +32,7 @@ static double since(Clock::time_point t) { return std::chrono::duration<double>(
 
 int main(int argc, char** argv) {
     if (argc < 3) {
-        std::fprintf(stderr, "usage: bench_modulus L seed|even [gamma]\n");
+        std::fprintf(stderr, "usage: bench_modulus L seed|even [gamma] [none|ends|dangling,ends]\n");
         return 2;
     }
     MikadoParams mp;
@@ -39,7 +41,10 @@ int main(int argc, char** argv) {
     dp.scheme = parse_scheme(argv[2]);
     dp.aspect_ratio = 10;
     const double gamma = argc > 3 ? std::atof(argv[3]) : 0.01;
-    const Network net = generate_mikado(mp);
+    const std::string rules = argc > 4 ? argv[4] : "none";
+    dp.trim_ends = rules.find("ends") != std::string::npos;
+    Network net = generate_mikado(mp);
+    if (rules.find("dangling") != std::string::npos) net = prune(net, PruneOptions{true, false});
     const Model m = discretize(net, dp);
     NetworkEnergy e(m);
     const int n = e.num_dofs();

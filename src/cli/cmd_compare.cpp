@@ -47,6 +47,7 @@ void register_compare(CLI::App& app) {
     cmd->footer("Without a scene file the discretization defaults to the tested one: --scheme even --h 10 --a 3.");
     cmd->callback([=] {
         Scene s = flags->resolve();
+        refuse_trimmed_ends(s, "compare", "the comparison needs the whole fibers of the pebble game");
         if (flags->scene_file.empty()) {
             if (!flags->given("--scheme")) s.discretization.scheme = Scheme::Even;
             if (!flags->given("--h")) s.discretization.h = 10;

@@ -108,6 +108,7 @@ void register_modulus(CLI::App& app) {
                    {"energy", {{"total", eq.energy}, {"stretch", eq.stretch}, {"bend", eq.bend}}},
                    {"network", to_json(statistics(net))},
                    {"model", to_json(summarize(m))},
+                   {"prune", prune_rules(s)},
                    {"scheme", to_string(s.discretization.scheme)},
                    {"solver", solve_json(eq.result, s.solver.tol)},
                    {"start", eq.start},

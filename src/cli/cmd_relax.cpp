@@ -54,6 +54,7 @@ void register_relax(CLI::App& app) {
                    {"stress", st},
                    {"energy", {{"total", eq.energy}, {"stretch", eq.stretch}, {"bend", eq.bend}}},
                    {"model", to_json(summarize(m))},
+                   {"prune", prune_rules(s)},
                    {"solver", solve_json(eq.result, s.solver.tol)},
                    {"start", eq.start},
                    {"output", eq.converged() && !out->empty() ? nlohmann::json(*out) : nlohmann::json()}});

@@ -51,6 +51,7 @@ void register_rigidity(CLI::App& app) {
     cmd->add_flag("--clusters", *clusters, "also list the rigid cluster of every fiber");
     cmd->callback([=] {
         Scene s = flags->resolve();
+        refuse_trimmed_ends(s, "rigidity", "the pebble game treats whole fibers as rigid rods");
         auto t0 = std::chrono::steady_clock::now();
         const Network net = scene_network(s);
         const double t_net = seconds_since(t0);

@@ -56,6 +56,7 @@ void register_wet(CLI::App& app) {
     cmd->callback([=] {
         const auto t_all = std::chrono::steady_clock::now();
         Scene s = flags->resolve();
+        refuse_trimmed_ends(s, "wet", "capillary bridges sit on the end arms");
         if (flags->scene_file.empty() && !flags->given("--pl")) s.mikado.pl = 0.5;  // the thesis's wet networks
         if (o_beta->count()) s.wet.beta = w->beta;
         if (o_law->count()) s.wet.law = w->law;

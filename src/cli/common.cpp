@@ -22,7 +22,7 @@ void SceneFlags::add(CLI::App* app, bool with_load) {
     opts.push_back(app->add_option("--nseg", n_seg, "seed scheme: segments per fiber (default 10)"));
     opts.push_back(app->add_option("--h", h, "even scheme: segment length in seed units (default 1)"));
     opts.push_back(app->add_option("--a", a, "fiber aspect ratio a = ls / r (default 10)"));
-    opts.push_back(app->add_option("--prune", prune, "drop load-free parts: dangling, nonspanning"));
+    opts.push_back(app->add_option("--prune", prune, "drop load-free parts: dangling, nonspanning, ends (docs/moduli.md)"));
     if (with_load) {
         opts.push_back(app->add_option("--gamma", gamma, "strain parameter (default 0)"));
         opts.push_back(app->add_option("--strain", strain, "strain path: shear | uniaxial | uniaxial-y | isotropic"));
@@ -60,7 +60,8 @@ Scene SceneFlags::resolve() const {
         for (const auto& p : prune) {
             if (p == "dangling") s.prune.dangling = true;
             else if (p == "nonspanning") s.prune.nonspanning = true;
-            else throw InputError("command line: --prune " + p + " is unknown (expected dangling or nonspanning)");
+            else if (p == "ends") s.discretization.trim_ends = true;
+            else throw InputError("command line: --prune " + p + " is unknown (expected dangling, nonspanning or ends)");
         }
     }
     set("--gamma", s.gamma, gamma);
@@ -104,6 +105,19 @@ int& exit_code() {
 
 double seconds_since(const std::chrono::steady_clock::time_point& t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+nlohmann::json prune_rules(const Scene& s) {
+    nlohmann::json j = nlohmann::json::array();
+    if (s.prune.dangling) j.push_back("dangling");
+    if (s.prune.nonspanning) j.push_back("nonspanning");
+    if (s.discretization.trim_ends) j.push_back("ends");
+    return j;
+}
+
+void refuse_trimmed_ends(const Scene& s, const std::string& command, const std::string& why) {
+    if (s.discretization.trim_ends)
+        throw InputError(s.source + ": prune \"ends\" is not valid for `fibernet " + command + "`: " + why);
 }
 
 }  // namespace fibernet::cli

@@ -30,7 +30,11 @@ struct SceneFlags {
     Scene resolve() const;  // scene file (or defaults) overridden by the flags given
 };
 
+// Commands whose physics acts on fiber end arms (bridges, clamps, rods) refuse `prune ends` with an InputError.
+void refuse_trimmed_ends(const Scene& s, const std::string& command, const std::string& why);
+
 nlohmann::json to_json(const NetworkStats& s);
+nlohmann::json prune_rules(const Scene& s);  // the pruning rules applied, e.g. ["dangling", "ends"]
 nlohmann::json to_json(const ModelSummary& s);
 
 // Prints JSON to stdout (or to `path` atomically when non-empty).

@@ -136,6 +136,12 @@ Model discretize(const Network& net, const DiscretizationParams& p) {
             }
             pts.swap(fine);
         }
+        if (p.trim_ends) {
+            auto first = std::find_if(pts.begin(), pts.end(), [](const Pin& q) { return q.crossing >= 0; });
+            auto last = std::find_if(pts.rbegin(), pts.rend(), [](const Pin& q) { return q.crossing >= 0; });
+            if (first == pts.end()) pts.clear();
+            else pts = std::vector<Pin>(first, last.base());
+        }
         FiberChain& ch = m.chains[f];
         const Eigen::Vector2d u = fib.direction();
         std::vector<Eigen::Vector2i> wraps;

@@ -131,7 +131,8 @@ Scene parse_scene(const std::string& text, const std::string& source) {
                 auto v = el.value_exact<std::string>();
                 if (v && *v == "dangling") s.prune.dangling = true;
                 else if (v && *v == "nonspanning") s.prune.nonspanning = true;
-                else throw InputError(source + ": [model].prune has an unknown entry (expected \"dangling\", \"nonspanning\")");
+                else if (v && *v == "ends") s.discretization.trim_ends = true;
+                else throw InputError(source + ": [model].prune has an unknown entry (expected \"dangling\", \"nonspanning\", \"ends\")");
             }
         } else if (r.t.get("prune")) {
             throw InputError(source + ": [model].prune must be an array of strings");

@@ -36,6 +36,18 @@ TEST_CASE("cli modulus: converged JSON with moduli, energy split, sizes and timi
     CHECK(j["linear_solve"]["factorizations"].get<int>() == 1);
 }
 
+TEST_CASE("cli modulus: --prune ends gives the same G and K with fewer unknowns", "[cli][modulus][prune]") {
+    REQUIRE(run("modulus --L 3 --q 8 --scheme even --a 10 --seed 7") == 0);
+    const auto full = out();
+    REQUIRE(run("modulus --L 3 --q 8 --scheme even --a 10 --seed 7 --prune ends") == 0);
+    const auto trimmed = out();
+    CHECK(trimmed["model"]["dofs"].get<int>() < full["model"]["dofs"].get<int>());
+    for (const char* m : {"G", "K"})
+        CHECK(trimmed["moduli"][m].get<double>() == Approx(full["moduli"][m].get<double>()).epsilon(1e-6));
+    CHECK(run("modulus --L 3 --q 8 --prune tips") == 2);
+    CHECK(slurp(dir() + "/stderr").find("--prune tips is unknown") != std::string::npos);
+}
+
 TEST_CASE("cli modulus: the default scene converges", "[cli][modulus]") {
     REQUIRE(run(std::string(FIBERNET_SOURCE_DIR) + "/problems/default.toml") == 2);  // a scene alone is no command
     REQUIRE(run("modulus " + std::string(FIBERNET_SOURCE_DIR) + "/problems/default.toml") == 0);

@@ -152,3 +152,53 @@ TEST_CASE("model export round-trips exactly", "[model][io]") {
                            "softcore_eps_star -0.95\nnodes 1\n0 0 0 0 0\nsegments 1\n0 3 0 0 1 0 400\n");
     CHECK_THROWS_WITH(read_model(bad, "m.txt"), Catch::Contains("m.txt:10: segment node j = 3 is out of range"));
 }
+
+TEST_CASE("discretize trim_ends: chains run from the first to the last crosslink, interior unchanged", "[model][prune]") {
+    for (Scheme s : {Scheme::Seed, Scheme::Even}) {
+        const Network net = net_L4(0.6);
+        DiscretizationParams d;
+        d.scheme = s;
+        const Model full = discretize(net, d);
+        d.trim_ends = true;
+        const Model trimmed = discretize(net, d);
+        REQUIRE(trimmed.chains.size() == full.chains.size());
+        CHECK(trimmed.supernodes.size() == full.supernodes.size());
+        CHECK(trimmed.num_nodes() < full.num_nodes());
+        int empty = 0, single = 0;
+        for (size_t f = 0; f < full.chains.size(); ++f) {
+            const FiberChain &a = full.chains[f], &b = trimmed.chains[f];
+            int pins = 0;
+            for (int v : a.nodes)
+                for (const auto& sn : full.supernodes) pins += sn.node == v;
+            if (pins == 0) {
+                CHECK(b.nodes.empty());
+                ++empty;
+                continue;
+            }
+            REQUIRE(!b.nodes.empty());
+            single += pins == 1;
+            CHECK(b.segments.size() + 1 == b.nodes.size());
+            // The trimmed chain is a contiguous run of the full one: same arc positions, same node positions.
+            size_t k0 = 0;
+            while (k0 < a.s.size() && a.s[k0] != b.s.front()) ++k0;
+            REQUIRE(k0 + b.s.size() <= a.s.size());
+            for (size_t k = 0; k < b.s.size(); ++k) {
+                CHECK(b.s[k] == a.s[k0 + k]);
+                CHECK((trimmed.x.segment<2>(2 * b.nodes[k]) - full.x.segment<2>(2 * a.nodes[k0 + k])).norm() == 0);
+            }
+            // Both ends are crosslinks: nothing hangs beyond them.
+            auto is_pin = [&](int v) {
+                for (const auto& sn : trimmed.supernodes)
+                    if (sn.node == v) return true;
+                return false;
+            };
+            CHECK(is_pin(b.nodes.front()));
+            CHECK(is_pin(b.nodes.back()));
+        }
+        CHECK(empty > 0);   // pl = 0.6 leaves fibers without crosslinks: the test covers them
+        CHECK(single > 0);  // and fibers pinned once (reduced to their pin)
+        // Every crosslink still maps to a node.
+        for (size_t k = 0; k < net.crossings.size(); ++k)
+            CHECK((trimmed.crossing_node[k] >= 0) == net.crossings[k].crosslink);
+    }
+}

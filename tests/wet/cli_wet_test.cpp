@@ -41,7 +41,8 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
     for (const Case& c : {Case{"--beta -1", "beta = -1"}, Case{"--beta nan", "beta"}, Case{"--betas 0,-0.5", "-0.5"},
                           Case{"--crossings fraction --fraction 2", "fraction = 2"},
                           Case{"--crossings some", "some"}, Case{"--law " + law, "100"},
-                          Case{"--law " + unsorted, "30"}, Case{scene, "fraction = 1.5"}}) {
+                          Case{"--law " + unsorted, "30"}, Case{scene, "fraction = 1.5"},
+                          Case{"--prune ends", "prune \"ends\" is not valid for `fibernet wet`"}}) {
         INFO(c.args);
         CHECK(run("--L 2.5 --q 5 " + c.args + " -o " + out) == 2);
         CHECK(slurp(tmpdir() + "/stderr").find(c.needle) != std::string::npos);

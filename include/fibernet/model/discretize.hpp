@@ -19,6 +19,11 @@ struct DiscretizationParams {
     double h = 1.0;             // even scheme: target segment length (seed units)
     double fiber_length = 10;   // lf in seed units (ls = lf / 10 defines the unit of length)
     double aspect_ratio = 10;   // a = ls / r
+    // Drop each fiber's end arms beyond its outermost crosslinks (and fibers with no crosslink). Exact for dry
+    // equilibria and moduli: a load-free arm stays straight with zero energy and exerts no force or moment on its
+    // pin whatever the pin does, so the kept nodes and their equilibrium are unchanged (docs/moduli.md, "Pruning").
+    // Not for wet networks or clamped open boxes: bridges and clamps act on the arms.
+    bool trim_ends = false;
 
     void check(const std::string& where) const;  // throws InputError naming the bad value
 };
