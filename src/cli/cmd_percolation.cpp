@@ -2,7 +2,9 @@
 // networks for a list of box sizes L (issue 4 part 4, seed figure 3.6). Samples run on --threads threads; each
 // finished sample is appended to the CSV at once, so an interrupted run keeps its work and --resume continues
 // it (rows are keyed by L, q and sample number, and every sample's seed derives from them). Then the
-// inflection point q_1/2(L) is fitted per L (probit, binomial likelihood) and q_1/2(L) = q_c + A L^(-1/nu).
+// inflection point q_1/2(L) is fitted per L (probit, binomial likelihood) and q_1/2(L) = q_c + A L^(-1/nu);
+// nu also from the probit widths, width(L) = c L^(-1/nu), and q_c with nu held at that estimate.
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -80,6 +82,33 @@ nlohmann::json fit_json(const ScalingFit& f) {
     if (!f.ok) return nullptr;
     return {{"q_c", f.q_c}, {"q_c_err", f.q_c_err}, {"nu", f.nu},   {"nu_err", f.nu_err},
             {"A", f.A},     {"A_err", f.A_err},     {"chi2", f.chi2}, {"dof", f.dof}};
+}
+nlohmann::json fit_json(const WidthScalingFit& f) {
+    if (!f.ok) {
+        nlohmann::json j = {{"no_fit", f.reason}, {"points", f.points}};
+        if (std::isfinite(f.inv_nu)) j["inv_nu"] = f.inv_nu, j["inv_nu_err"] = f.inv_nu_err;
+        return j;
+    }
+    return {{"inv_nu", f.inv_nu}, {"inv_nu_err", f.inv_nu_err}, {"nu", f.nu}, {"nu_err", f.nu_err}, {"c", f.c},
+            {"c_err", f.c_err},   {"chi2", f.chi2},             {"dof", f.dof}, {"points", f.points}};
+}
+// q_c with nu from the widths: the fixed-nu fit's fields plus the two parts of the q_c and A errors.
+nlohmann::json width_nu_json(const ScalingFit& f) {
+    nlohmann::json j = fit_json(f);
+    if (!j.is_null())
+        j["q_c_err_stat"] = f.q_c_err_stat, j["q_c_err_nu"] = f.q_c_err_nu, j["A_err_stat"] = f.A_err_stat,
+        j["A_err_nu"] = f.A_err_nu;
+    return j;
+}
+// The width fit without the smallest size (a check for corrections to scaling at small L) or without the largest
+// (whose width, the narrowest, rests on the fewest densities inside the transition).
+WidthScalingFit width_fit_without(std::vector<double> L, std::vector<double> w, std::vector<double> e, bool largest) {
+    if (!L.empty()) {
+        const size_t k = (largest ? std::max_element(L.begin(), L.end()) : std::min_element(L.begin(), L.end())) -
+                         L.begin();
+        L.erase(L.begin() + k), w.erase(w.begin() + k), e.erase(e.begin() + k);
+    }
+    return fit_width_scaling(L, w, e);
 }
 }  // namespace
 
@@ -183,7 +212,7 @@ void register_percolation(CLI::App& app) {
         std::ostringstream table;
         table << "pl,L,q,samples,P_rigid,P_connected\n";
         nlohmann::json per_L = nlohmann::json::array();
-        std::vector<double> Lr, yr, er, Lc, yc, ec;
+        std::vector<double> Lr, yr, er, wr, wer, Lc, yc, ec, wc, wec;  // sizes with a probit fit: q_1/2, width
         for (const auto& [L, byq] : counts) {
             std::vector<double> qs;
             std::vector<int> n, hr, hc;
@@ -193,14 +222,20 @@ void register_percolation(CLI::App& app) {
                       << fmt(double(c[2]) / c[0]) << '\n';
             }
             const ProbitFit fr = fit_spanning_probability(qs, hr, n), fc = fit_spanning_probability(qs, hc, n);
-            if (fr.ok) Lr.push_back(L), yr.push_back(fr.q_half), er.push_back(fr.q_half_err);
-            if (fc.ok) Lc.push_back(L), yc.push_back(fc.q_half), ec.push_back(fc.q_half_err);
+            if (fr.ok)
+                Lr.push_back(L), yr.push_back(fr.q_half), er.push_back(fr.q_half_err), wr.push_back(fr.width),
+                    wer.push_back(fr.width_err);
+            if (fc.ok)
+                Lc.push_back(L), yc.push_back(fc.q_half), ec.push_back(fc.q_half_err), wc.push_back(fc.width),
+                    wec.push_back(fc.width_err);
             long samples = 0;
             for (int k : n) samples += k;
             per_L.push_back({{"L", L}, {"samples", samples}, {"densities", qs.size()}, {"rigid", fit_json(fr)},
                              {"connected", fit_json(fc)}});
         }
         if (!o->table.empty()) write_file_atomic(o->table, table.str());
+        // nu from the probit widths, width(L) = c L^(-1/nu), then q_c with nu held there (docs/rigidity.md).
+        const WidthScalingFit width_r = fit_width_scaling(Lr, wr, wer), width_c = fit_width_scaling(Lc, wc, wec);
         double cpu = 0;
         for (const auto& r : rows) cpu += r.seconds;
         emit_json({{"pl", o->pl},
@@ -215,7 +250,17 @@ void register_percolation(CLI::App& app) {
                      // Known exponents: 2D rigidity percolation nu = 1.21 (Jacobs & Thorpe 1995, bond-diluted
                      // triangular lattice), 2D connectivity percolation nu = 4/3 (exact).
                      {"rigid_nu_1.21", fit_json(fit_finite_size_scaling_fixed_nu(Lr, yr, er, 1.21))},
-                     {"connected_nu_4/3", fit_json(fit_finite_size_scaling_fixed_nu(Lc, yc, ec, 4.0 / 3.0))}}}},
+                     {"connected_nu_4/3", fit_json(fit_finite_size_scaling_fixed_nu(Lc, yc, ec, 4.0 / 3.0))},
+                     {"width_model", "width(L) = c L^(-1/nu)"},
+                     {"rigid_width", fit_json(width_r)},
+                     {"connected_width", fit_json(width_c)},
+                     {"rigid_width_without_smallest_L", fit_json(width_fit_without(Lr, wr, wer, false))},
+                     {"connected_width_without_smallest_L", fit_json(width_fit_without(Lc, wc, wec, false))},
+                     {"rigid_width_without_largest_L", fit_json(width_fit_without(Lr, wr, wer, true))},
+                     {"connected_width_without_largest_L", fit_json(width_fit_without(Lc, wc, wec, true))},
+                     {"rigid_nu_from_width", width_nu_json(fit_finite_size_scaling_width_nu(Lr, yr, er, width_r))},
+                     {"connected_nu_from_width",
+                      width_nu_json(fit_finite_size_scaling_width_nu(Lc, yc, ec, width_c))}}}},
                   o->summary);
     });
 }

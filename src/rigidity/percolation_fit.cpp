@@ -151,4 +151,76 @@ ScalingFit fit_finite_size_scaling_fixed_nu(const std::vector<double>& L, const 
     return f;
 }
 
+WidthScalingFit fit_width_scaling(const std::vector<double>& L, const std::vector<double>& width,
+                                  const std::vector<double>& width_err) {
+    WidthScalingFit f;
+    if (L.size() != width.size() || L.size() != width_err.size()) {
+        f.reason = "L, width and width_err differ in length";
+        return f;
+    }
+    auto good = [](double v) { return std::isfinite(v) && v > 0; };
+    std::vector<double> x, y, s;  // log L, log width, its standard error
+    for (size_t i = 0; i < L.size(); ++i)
+        if (good(L[i]) && good(width[i]) && good(width_err[i]))
+            x.push_back(std::log(L[i])), y.push_back(std::log(width[i])), s.push_back(width_err[i] / width[i]);
+    const int m = static_cast<int>(x.size());
+    f.points = m;
+    if (m < 2) {
+        f.reason = "fewer than 2 sizes with a valid width (" + std::to_string(m) + ")";
+        return f;
+    }
+    if (*std::max_element(x.begin(), x.end()) - *std::min_element(x.begin(), x.end()) < 1e-12) {
+        f.reason = "all sizes equal";
+        return f;
+    }
+    // y = b0 - b1 x: columns (1, -x).
+    Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d r = Eigen::Vector2d::Zero();
+    for (int i = 0; i < m; ++i) {
+        const double w = 1 / (s[i] * s[i]);
+        const Eigen::Vector2d b(1, -x[i]);
+        M += w * b * b.transpose();
+        r += w * y[i] * b;
+    }
+    const Eigen::Vector2d sol = M.ldlt().solve(r);
+    double chi2 = 0;
+    for (int i = 0; i < m; ++i) chi2 += std::pow((y[i] - sol(0) + sol(1) * x[i]) / s[i], 2);
+    f.dof = m - 2;
+    f.chi2 = chi2;
+    const Eigen::Matrix2d cov = M.inverse() * (f.dof > 0 ? std::max(1.0, chi2 / f.dof) : 1.0);
+    if (!sol.allFinite() || !cov.allFinite()) {
+        f.reason = "singular normal equations";
+        return f;
+    }
+    f.inv_nu = sol(1);
+    f.inv_nu_err = std::sqrt(std::max(0.0, cov(1, 1)));
+    if (!(f.inv_nu > 0)) {
+        f.reason = "the widths do not fall with L (1/nu = " + std::to_string(f.inv_nu) + ")";
+        return f;
+    }
+    f.nu = 1 / f.inv_nu;
+    f.nu_err = f.inv_nu_err / (f.inv_nu * f.inv_nu);
+    f.c = std::exp(sol(0));
+    f.c_err = f.c * std::sqrt(std::max(0.0, cov(0, 0)));
+    f.ok = true;
+    return f;
+}
+
+ScalingFit fit_finite_size_scaling_width_nu(const std::vector<double>& L, const std::vector<double>& q_half,
+                                            const std::vector<double>& err, const WidthScalingFit& w) {
+    if (!w.ok || !(w.inv_nu > 0) || !std::isfinite(w.inv_nu_err)) return {};
+    const double lo = w.inv_nu - w.inv_nu_err, hi = w.inv_nu + w.inv_nu_err;
+    if (!(lo > 0)) return {};  // one standard error reaches 1/nu = 0: the shifts do not define q_c
+    ScalingFit f = fit_finite_size_scaling_fixed_nu(L, q_half, err, w.nu);
+    const ScalingFit a = fit_finite_size_scaling_fixed_nu(L, q_half, err, 1 / hi),
+                     b = fit_finite_size_scaling_fixed_nu(L, q_half, err, 1 / lo);
+    if (!f.ok || !a.ok || !b.ok) return {};
+    f.nu_err = w.nu_err;
+    f.q_c_err_stat = f.q_c_err, f.A_err_stat = f.A_err;
+    f.q_c_err_nu = 0.5 * std::abs(a.q_c - b.q_c), f.A_err_nu = 0.5 * std::abs(a.A - b.A);
+    f.q_c_err = std::hypot(f.q_c_err_stat, f.q_c_err_nu);
+    f.A_err = std::hypot(f.A_err_stat, f.A_err_nu);
+    return f;
+}
+
 }  // namespace fibernet
