@@ -1,5 +1,7 @@
 #include "fibernet/mechanics/moduli.hpp"
 
+#include <numeric>
+#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <algorithm>
@@ -86,135 +88,152 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
         return out;
     }
 
-    // One factorization of H + delta I; grow delta if round-off makes the (PSD, singular) H fail to factor.
-    double dm = 0;
-    for (int j = 0; j < n; ++j) dm += std::abs(H.coeff(j, j));
-    dm = std::max(dm / n, std::numeric_limits<double>::min());
+    // Shift scale: first the median |diagonal|; the mean, which a few segments of 1e-5 (stiffness 1/l) inflate by
+    // 1e2..1e5 at L = 80, leaves many soft modes below the shift for the CG (measured at L = 80: 23 and 15 steps
+    // against 3 and 12, and a K whose CG stopped 2e-3 short of the median-shift value with a bound of 6e-5). With the
+    // smaller shift, round-off in the null space of a floppy network can stop the CG before it converges; then the
+    // solve is repeated with the mean scale, at least 100x the median (one more factorization).
+    std::vector<double> diag(n);
+    for (int j = 0; j < n; ++j) diag[j] = std::abs(H.coeff(j, j));
+    const double mean_scale = std::max(std::accumulate(diag.begin(), diag.end(), 0.0) / n, std::numeric_limits<double>::min());
+    std::nth_element(diag.begin(), diag.begin() + n / 2, diag.end());
+    const double median_scale = std::max(diag[n / 2], std::numeric_limits<double>::min());
+    const std::vector<Modulus> base = out;
     CholmodLLT own;
     CholmodLLT& llt = shared_llt ? *shared_llt : own;
-    t0 = Clock::now();
-    if (!llt.analyzed()) llt.analyze(H);  // a shared wrapper of another pattern is re-analyzed by factorize()
-    inf.seconds_factorization += since(t0);
-    bool factored = false;
-    double delta = opt.delta_rel * dm;
-    for (int k = 0; k < 8 && !factored; ++k, delta *= 100) {
+    auto attempt = [&](double dm) -> bool {
+        out = base;
+        // One factorization of H + delta I; grow delta if round-off makes the (PSD, singular) H fail to factor.
         t0 = Clock::now();
-        factored = llt.factorize(H, delta);
-        inf.seconds_one_factorization = since(t0);
-        inf.seconds_factorization += inf.seconds_one_factorization;
-        ++inf.factorizations;
-        if (factored) inf.delta = delta;
-    }
-    if (!factored) {
-        inf.message = "H + delta I is not positive definite up to delta = 1e2 mean diag(H): not a stable equilibrium";
-        inf.seconds_total = since(t_start);
-        return out;
-    }
+        if (!llt.analyzed()) llt.analyze(H);  // a shared wrapper of another pattern is re-analyzed by factorize()
+        inf.seconds_factorization += since(t0);
+        bool factored = false;
+        double delta = opt.delta_rel * dm;
+        for (int k = 0; k < 8 && !factored; ++k, delta *= 100) {
+            t0 = Clock::now();
+            factored = llt.factorize(H, delta);
+            inf.seconds_one_factorization = since(t0);
+            inf.seconds_factorization += inf.seconds_one_factorization;
+            ++inf.factorizations;
+            if (factored) inf.delta = delta;
+        }
+        if (!factored) {
+            inf.message = "H + delta I is not positive definite up to delta = 1e2 diag scale of H: not a stable equilibrium";
+            return false;
+        }
 
-    // Iterative refinement towards H^+ b, all modes at once (one multi-column solve per step).
-    t0 = Clock::now();
-    const auto Hs = H.selfadjointView<Eigen::Upper>();
-    const Eigen::Matrix2d Finv = F.inverse();
-    const Eigen::VectorXd x = e.positions(q, F);  // absolute positions: the affine velocity is dF F^-1 x
-    const int M = static_cast<int>(modes.size());
-    Eigen::MatrixXd B(n, M), V(n, M);
-    for (int m = 0; m < M; ++m) {
-        // Comoving (affine) coordinates: with v = dF F^{-1} x the affine velocity of the free nodes,
-        //   E_tt - b.H^+ b = (E_tt + 2 v.b + v.H v) - (b + H v).H^+ (b + H v)     (b in range(H)),
-        // whose two terms are the affine and non-affine parts: O(G A) instead of O(L^2 k) with absolute
-        // coordinates, where box-crossing segments make E_tt ~ 1e8 and the cancellation costs 6 digits.
-        const Eigen::Matrix2d Vm = modes[m].dF * Finv;
-        Eigen::VectorXd v(n);
-        for (int i = 0; i < e.model().num_nodes(); ++i)
-            if (e.dof(i, 0) >= 0) v.segment<2>(e.dof(i, 0)) = Vm * x.segment<2>(2 * i);
-        const Eigen::VectorXd Hv = Hs * v;
-        out[m].E_tt += 2 * v.dot(b[m]) + v.dot(Hv);
-        B.col(m) = b[m] + Hv;
-        V.col(m) = v;
-    }
-    // Preconditioned conjugate gradients on H u = b with the preconditioner (H + delta I)^{-1}, one independent CG
-    // per mode, all modes' preconditioner solves in one multi-column CHOLMOD call. The preconditioned spectrum is
-    // lambda / (lambda + delta): 1 for every stiff mode, so CG only has to resolve the few modes with lambda ~ delta
-    // (plain refinement u += (H + delta I)^{-1} (b - H u) crawls on those: measured 0.55 per step at L = 20). With
-    // u_0 = 0 the iterates stay in range(H) when b does, and c_k = b.u_k rises monotonically to b.H^+ b.
-    Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n, M), R = B, Z = llt.solve_many(R), P = Z;
-    std::vector<double> c(M, 0.0), inc(M, std::numeric_limits<double>::infinity()),
-        prev_inc(M, std::numeric_limits<double>::infinity()), scale_ref(M), rz(M), rz0(M);
-    std::vector<int> steps(M, 0);
-    std::vector<char> conv(M, 0), noise(M, 0), broke(M, 0);
-    for (int m = 0; m < M; ++m) {
-        rz[m] = rz0[m] = R.col(m).dot(Z.col(m));
-        scale_ref[m] = std::max({std::abs(out[m].E_tt), rz[m], std::numeric_limits<double>::min()});
-        conv[m] = rz[m] == 0;  // b = 0
-    }
-    auto active = [&](int m) { return !conv[m] && !noise[m] && !broke[m] && steps[m] < opt.max_refinements; };
-    for (;;) {
-        bool any = false;
-        for (int m = 0; m < M; ++m) any = any || active(m);
-        if (!any) break;
+        // Iterative refinement towards H^+ b, all modes at once (one multi-column solve per step).
+        t0 = Clock::now();
+        const auto Hs = H.selfadjointView<Eigen::Upper>();
+        const Eigen::Matrix2d Finv = F.inverse();
+        const Eigen::VectorXd x = e.positions(q, F);  // absolute positions: the affine velocity is dF F^-1 x
+        const int M = static_cast<int>(modes.size());
+        Eigen::MatrixXd B(n, M), V(n, M);
         for (int m = 0; m < M; ++m) {
-            if (!active(m)) continue;
-            const Eigen::VectorXd Ap = Hs * P.col(m);
-            const double pAp = P.col(m).dot(Ap);
-            if (!(pAp > 0)) {
-                // After the first steps p is round-off (its null-space part amplified by M): stop there. At the
-                // start it means negative curvature along M b: a saddle, not a minimum.
-                if (rz[m] <= 1e-16 * rz0[m]) conv[m] = 1;  // the residual is round-off: converged
-                else if (steps[m] >= 1) noise[m] = 1;           // round-off direction; `error` says how far we got
-                else broke[m] = 1;
-                continue;
+            // Comoving (affine) coordinates: with v = dF F^{-1} x the affine velocity of the free nodes,
+            //   E_tt - b.H^+ b = (E_tt + 2 v.b + v.H v) - (b + H v).H^+ (b + H v)     (b in range(H)),
+            // whose two terms are the affine and non-affine parts: O(G A) instead of O(L^2 k) with absolute
+            // coordinates, where box-crossing segments make E_tt ~ 1e8 and the cancellation costs 6 digits.
+            const Eigen::Matrix2d Vm = modes[m].dF * Finv;
+            Eigen::VectorXd v(n);
+            for (int i = 0; i < e.model().num_nodes(); ++i)
+                if (e.dof(i, 0) >= 0) v.segment<2>(e.dof(i, 0)) = Vm * x.segment<2>(2 * i);
+            const Eigen::VectorXd Hv = Hs * v;
+            out[m].E_tt += 2 * v.dot(b[m]) + v.dot(Hv);
+            B.col(m) = b[m] + Hv;
+            V.col(m) = v;
+        }
+        // Preconditioned conjugate gradients on H u = b with the preconditioner (H + delta I)^{-1}, one independent CG
+        // per mode, all modes' preconditioner solves in one multi-column CHOLMOD call. The preconditioned spectrum is
+        // lambda / (lambda + delta): 1 for every stiff mode, so CG only has to resolve the few modes with lambda ~ delta
+        // (plain refinement u += (H + delta I)^{-1} (b - H u) crawls on those: measured 0.55 per step at L = 20). With
+        // u_0 = 0 the iterates stay in range(H) when b does, and c_k = b.u_k rises monotonically to b.H^+ b.
+        Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n, M), R = B, Z = llt.solve_many(R), P = Z;
+        std::vector<double> c(M, 0.0), inc(M, std::numeric_limits<double>::infinity()),
+            prev_inc(M, std::numeric_limits<double>::infinity()), scale_ref(M), rz(M), rz0(M);
+        std::vector<int> steps(M, 0);
+        std::vector<char> conv(M, 0), noise(M, 0), broke(M, 0);
+        for (int m = 0; m < M; ++m) {
+            rz[m] = rz0[m] = R.col(m).dot(Z.col(m));
+            scale_ref[m] = std::max({std::abs(out[m].E_tt), rz[m], std::numeric_limits<double>::min()});
+            conv[m] = rz[m] == 0;  // b = 0
+        }
+        auto active = [&](int m) { return !conv[m] && !noise[m] && !broke[m] && steps[m] < opt.max_refinements; };
+        for (;;) {
+            bool any = false;
+            for (int m = 0; m < M; ++m) any = any || active(m);
+            if (!any) break;
+            for (int m = 0; m < M; ++m) {
+                if (!active(m)) continue;
+                const Eigen::VectorXd Ap = Hs * P.col(m);
+                const double pAp = P.col(m).dot(Ap);
+                if (!(pAp > 0)) {
+                    // After the first steps p is round-off (its null-space part amplified by M): stop there. At the
+                    // start it means negative curvature along M b: a saddle, not a minimum.
+                    if (rz[m] <= 1e-16 * rz0[m]) conv[m] = 1;  // the residual is round-off: converged
+                    else if (steps[m] >= 1) noise[m] = 1;           // round-off direction; `error` says how far we got
+                    else broke[m] = 1;
+                    continue;
+                }
+                const double alpha = rz[m] / pAp;
+                U.col(m) += alpha * P.col(m);
+                R.col(m) -= alpha * Ap;
+                const double c_new = B.col(m).dot(U.col(m));
+                prev_inc[m] = inc[m];
+                inc[m] = std::abs(c_new - c[m]);
+                c[m] = c_new;
+                ++steps[m];
+                conv[m] = inc[m] <= opt.refine_tol * scale_ref[m];
+                noise[m] = steps[m] >= 3 && inc[m] <= 1e-11 * scale_ref[m] && inc[m] > 0.5 * prev_inc[m];  // round-off
             }
-            const double alpha = rz[m] / pAp;
-            U.col(m) += alpha * P.col(m);
-            R.col(m) -= alpha * Ap;
-            const double c_new = B.col(m).dot(U.col(m));
-            prev_inc[m] = inc[m];
-            inc[m] = std::abs(c_new - c[m]);
-            c[m] = c_new;
-            ++steps[m];
-            conv[m] = inc[m] <= opt.refine_tol * scale_ref[m];
-            noise[m] = steps[m] >= 3 && inc[m] <= 1e-11 * scale_ref[m] && inc[m] > 0.5 * prev_inc[m];  // round-off
+            std::vector<int> act;  // the preconditioner solve for the modes still running only
+            for (int m = 0; m < M; ++m)
+                if (active(m)) act.push_back(m);
+            if (act.empty()) break;
+            Eigen::MatrixXd Rn(n, static_cast<Eigen::Index>(act.size()));
+            for (size_t a = 0; a < act.size(); ++a) Rn.col(a) = R.col(act[a]);
+            const Eigen::MatrixXd Zn = llt.solve_many(Rn);
+            for (size_t a = 0; a < act.size(); ++a) Z.col(act[a]) = Zn.col(a);
+            for (int m : act) {
+                const double rz_new = R.col(m).dot(Z.col(m));
+                if (rz_new <= 1e-28 * rz0[m]) conv[m] = 1;  // residual at round-off
+                P.col(m) = Z.col(m) + (rz_new / rz[m]) * P.col(m);
+                rz[m] = rz_new;
+            }
         }
-        std::vector<int> act;  // the preconditioner solve for the modes still running only
-        for (int m = 0; m < M; ++m)
-            if (active(m)) act.push_back(m);
-        if (act.empty()) break;
-        Eigen::MatrixXd Rn(n, static_cast<Eigen::Index>(act.size()));
-        for (size_t a = 0; a < act.size(); ++a) Rn.col(a) = R.col(act[a]);
-        const Eigen::MatrixXd Zn = llt.solve_many(Rn);
-        for (size_t a = 0; a < act.size(); ++a) Z.col(act[a]) = Zn.col(a);
-        for (int m : act) {
-            const double rz_new = R.col(m).dot(Z.col(m));
-            if (rz_new <= 1e-28 * rz0[m]) conv[m] = 1;  // residual at round-off
-            P.col(m) = Z.col(m) + (rz_new / rz[m]) * P.col(m);
-            rz[m] = rz_new;
+        for (int m = 0; m < M; ++m) {
+            // CG increments: conv at 1e-13 of the scale; the tail estimate below bounds what is left.
+            if (broke[m]) inc[m] = prev_inc[m] = std::numeric_limits<double>::infinity();
         }
+        for (int m = 0; m < M; ++m) {
+            Modulus& Mo = out[m];
+            // Geometric tail: remaining error <= inc * rho / (1 - rho), rho = inc / prev_inc; at the round-off
+            // level the last increment itself is the error.
+            const double rho = std::isfinite(prev_inc[m]) && prev_inc[m] > 0 ? inc[m] / prev_inc[m] : 0.0;
+            const double tail =
+                noise[m] ? inc[m] : (rho < 1 ? inc[m] * rho / (1 - rho) : std::numeric_limits<double>::infinity());
+            Mo.refinements = steps[m];
+            Mo.response = U.col(m) - V.col(m);  // H (u - v) = (b + H v) - H v = E_xt
+            Mo.correction = c[m];
+            Mo.value = modes[m].scale * (Mo.E_tt - c[m]);
+            Mo.error = modes[m].scale * std::max(tail, 1e-15 * scale_ref[m]);  // floor at the cancellation round-off
+            // Accepted when converged, or stopped by round-off with the tail below 1e-7 of the cancellation scale
+            // (the seed scheme's 1e-4 segments at L = 20 end there; the error is reported).
+            Mo.ok = std::isfinite(Mo.value) && !broke[m] && (conv[m] || tail <= 1e-7 * scale_ref[m]);
+            if (at_affine) Mo.affine = modes[m].scale * Mo.E_tt;
+            if (!Mo.ok)
+                inf.message = broke[m] ? "H is not positive semidefinite at this state (a saddle): no modulus for " + Mo.name
+                                       : "conjugate gradients for H^+ E_xt did not converge for " + Mo.name;
+        }
+        inf.seconds_solve += since(t0);
+        for (const auto& m : out)
+            if (!m.ok) return false;
+        return true;
+    };
+    if (!attempt(median_scale)) {
+        inf.message.clear();
+        attempt(std::max(mean_scale, 100 * median_scale));
     }
-    for (int m = 0; m < M; ++m) {
-        // CG increments: conv at 1e-13 of the scale; the tail estimate below bounds what is left.
-        if (broke[m]) inc[m] = prev_inc[m] = std::numeric_limits<double>::infinity();
-    }
-    for (int m = 0; m < M; ++m) {
-        Modulus& Mo = out[m];
-        // Geometric tail: remaining error <= inc * rho / (1 - rho), rho = inc / prev_inc; at the round-off
-        // level the last increment itself is the error.
-        const double rho = std::isfinite(prev_inc[m]) && prev_inc[m] > 0 ? inc[m] / prev_inc[m] : 0.0;
-        const double tail =
-            noise[m] ? inc[m] : (rho < 1 ? inc[m] * rho / (1 - rho) : std::numeric_limits<double>::infinity());
-        Mo.refinements = steps[m];
-        Mo.response = U.col(m) - V.col(m);  // H (u - v) = (b + H v) - H v = E_xt
-        Mo.correction = c[m];
-        Mo.value = modes[m].scale * (Mo.E_tt - c[m]);
-        Mo.error = modes[m].scale * std::max(tail, 1e-15 * scale_ref[m]);  // floor at the cancellation round-off
-        // Accepted when converged, or stopped by round-off with the tail below 1e-7 of the cancellation scale
-        // (the seed scheme's 1e-4 segments at L = 20 end there; the error is reported).
-        Mo.ok = std::isfinite(Mo.value) && !broke[m] && (conv[m] || tail <= 1e-7 * scale_ref[m]);
-        if (at_affine) Mo.affine = modes[m].scale * Mo.E_tt;
-        if (!Mo.ok)
-            inf.message = broke[m] ? "H is not positive semidefinite at this state (a saddle): no modulus for " + Mo.name
-                                   : "conjugate gradients for H^+ E_xt did not converge for " + Mo.name;
-    }
-    inf.seconds_solve = since(t0);
     inf.seconds_total = since(t_start);
     return out;
 }

@@ -26,11 +26,16 @@ double mean_diag(const Eigen::SparseMatrix<double>& H) {
     return n > 0 ? s / n : 1.0;
 }
 
-// max_i sum_j |H_ij| ulp(q_j): the gradient error of rounding every coordinate to its floating-point spacing.
+// max_i sum_j |H_ij| ulp(max(|q_j|, 1)): the gradient error of rounding every coordinate to its floating-point spacing.
 double roundoff_floor(const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& q) {
     const int n = static_cast<int>(q.size());
     Eigen::VectorXd u(n), r = Eigen::VectorXd::Zero(n);
-    for (int j = 0; j < n; ++j) u[j] = std::nextafter(std::abs(q[j]), HUGE_VAL) - std::abs(q[j]);
+    // Coordinates are displacements (~0 near the reference) added to rest vectors of order one seed unit, so the
+    // rounding is that of max(|q_j|, 1), not of q_j itself.
+    for (int j = 0; j < n; ++j) {
+        const double a = std::max(std::abs(q[j]), 1.0);
+        u[j] = std::nextafter(a, HUGE_VAL) - a;
+    }
     for (int j = 0; j < n; ++j)
         for (int k = H.outerIndexPtr()[j]; k < H.outerIndexPtr()[j + 1]; ++k) {
             const int i = H.innerIndexPtr()[k];

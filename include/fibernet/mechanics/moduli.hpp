@@ -46,7 +46,7 @@ struct Modulus {
 };
 
 struct ModuliOptions {
-    double delta_rel = 1e-12;   // initial shift relative to mean |diag H| (x100 while the factorization fails)
+    double delta_rel = 1e-12;   // initial shift relative to median |diag H| (x100 while the factorization fails)
     int max_refinements = 200;  // conjugate-gradient steps
     double refine_tol = 1e-13;  // stop when a CG increment of E_xt.u is below this fraction of max(E_tt, b.M b)
 };
