@@ -105,6 +105,9 @@ void register_sweep(CLI::App& app) {
         SolverOptions so;
         so.tol = s.solver.tol, so.max_iter = s.solver.max_iter;
         auto solver = make_solver(s.solver.name, so);
+        SolverOptions so_snap = so;  // the snap-through budget at the smallest step (docs/sweep.md)
+        so_snap.max_iter = 10 * so.max_iter;
+        auto snap = make_solver(s.solver.name, so_snap);
         Network net = scene_network(s);
         Model m = discretize(net, s.discretization);
         NetworkEnergy e(m);
@@ -132,7 +135,7 @@ void register_sweep(CLI::App& app) {
         };
         std::signal(SIGINT, on_signal);
         std::signal(SIGTERM, on_signal);
-        const SweepOutcome o = run_sweep(e, *p, *solver, cb, *resume ? &start : nullptr);
+        const SweepOutcome o = run_sweep(e, *p, *solver, cb, *resume ? &start : nullptr, snap.get());
         std::signal(SIGINT, SIG_DFL);
         std::signal(SIGTERM, SIG_DFL);
         emit_json({{"status", o.completed ? "completed" : o.interrupted ? "interrupted" : "failed"},

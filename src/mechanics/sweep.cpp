@@ -55,7 +55,7 @@ Response respond(const NetworkEnergy& e, const Eigen::VectorXd& q, double t, Str
 }  // namespace
 
 SweepOutcome run_sweep(const NetworkEnergy& e, const SweepParams& p, Solver& solver, const SweepCallbacks& cb,
-                       const SweepState* resume) {
+                       const SweepState* resume, Solver* snap) {
     p.check("sweep");
     SweepOutcome out;
     const double dir = p.t_max > 0 ? 1 : -1;
@@ -104,6 +104,10 @@ SweepOutcome run_sweep(const NetworkEnergy& e, const SweepParams& p, Solver& sol
             const Eigen::VectorXd q_pred = s.q + (t_new - s.t) * resp.dq_dt;
             eq = relax(e, F, solver, &q_pred, F);
             iters += eq.result.iterations, facts += eq.result.factorizations;
+            if (snap && eq.result.status == SolveStatus::IterationLimit && 0.5 * h < p.min_step) {
+                eq = relax(e, F, *snap, &q_pred, F);  // last chance: a snap-through needs a long descent
+                iters += eq.result.iterations, facts += eq.result.factorizations;
+            }
             // A converged corrector is accepted; one that needed many iterations is first retried with a smaller
             // step (the tangent predicts better), but at the smallest step it is a snap-through: the branch ended
             // and the solver found the next stable state, which is what a quasistatic experiment does too.

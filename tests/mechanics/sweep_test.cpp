@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 
 #include "fibernet/mechanics/sweep.hpp"
 #include "fibernet/model/discretize.hpp"
@@ -10,18 +11,22 @@
 using namespace fibernet;
 
 namespace {
-Model sweep_model(double q = 7, double a = 10) {
+Model sweep_model(double q = 7, double a = 10, double L = 3, std::uint64_t seed = 4, double h = 2.5) {
     MikadoParams mp;
-    mp.L = 3, mp.q = q, mp.pl = 1, mp.seed = 4;
+    mp.L = L, mp.q = q, mp.pl = 1, mp.seed = seed;
     DiscretizationParams d;
-    d.scheme = Scheme::Even, d.h = 2.5, d.aspect_ratio = a;
+    d.scheme = Scheme::Even, d.h = h, d.aspect_ratio = a;
     return discretize(generate_mikado(mp), d);
 }
 
 std::vector<SweepRow> sweep_rows(const NetworkEnergy& e, const SweepParams& p, SweepOutcome* out = nullptr,
-                                 int stop_after = -1, const SweepState* resume = nullptr, SweepState* last = nullptr) {
+                                 int stop_after = -1, const SweepState* resume = nullptr, SweepState* last = nullptr,
+                                 int max_iter = 500, int snap_iter = 0) {
     SolverOptions so;
+    so.max_iter = max_iter;
     auto solver = make_solver("newton", so);
+    so.max_iter = snap_iter;
+    auto snap = make_solver("newton", so);
     std::vector<SweepRow> rows;
     std::atomic<bool> stop{false};
     SweepCallbacks cb;
@@ -31,7 +36,7 @@ std::vector<SweepRow> sweep_rows(const NetworkEnergy& e, const SweepParams& p, S
         if (last) *last = s;
         if (r.step == stop_after) stop = true;
     };
-    SweepOutcome o = run_sweep(e, p, *solver, cb, resume);
+    SweepOutcome o = run_sweep(e, p, *solver, cb, resume, snap_iter > 0 ? snap.get() : nullptr);
     if (out) *out = o;
     return rows;
 }
@@ -98,6 +103,29 @@ TEST_CASE("sweep: compression through buckling keeps every accepted step converg
     for (const auto& r : rows) CHECK(r.grad_max <= 1e-8);
     // Compressed fibers bend: the bending share of the energy grows along the sweep.
     CHECK(rows.back().bend > 0);
+}
+
+TEST_CASE("sweep: a snap-through beyond the solver's budget is crossed with the snap budget", "[mechanics][sweep]") {
+    // Shear of a 4 x 4 network to 40%: fibers buckle in cascades; measured with `fibernet sweep --L 4 --q 8
+    // --scheme even --gamma-max 0.5 --min-step 1e-3 --max-iter 20`, steps at the smallest size need 100s of iterations.
+    Model m = sweep_model(8, 10, 4, 1, 1.0);
+    NetworkEnergy e(m);
+    SweepParams p;
+    p.t_max = 0.4, p.step = 0.01, p.max_step = 0.05, p.min_step = 1e-3;
+    SweepOutcome tight, snapped;
+    const int budget = 20;
+    sweep_rows(e, p, &tight, -1, nullptr, nullptr, budget);
+    INFO(tight.message);
+    CHECK(!tight.completed);  // some step needs more than `budget` Newton iterations even at the smallest step
+    const auto rows = sweep_rows(e, p, &snapped, -1, nullptr, nullptr, budget, 100 * budget);
+    INFO(snapped.message);
+    CHECK(snapped.completed);
+    int over = 0;
+    for (const auto& r : rows) {
+        CHECK(r.grad_max <= 1e-8);  // every accepted step converged
+        over += r.iterations > budget;
+    }
+    CHECK(over > 0);  // and the snap budget was used
 }
 
 TEST_CASE("sweep: bad parameters name the value", "[mechanics][sweep][input]") {

@@ -68,7 +68,10 @@ struct SweepCallbacks {
 };
 
 // Runs (or, with `resume` non-null, continues) a sweep. The first row (t = 0) comes from relaxing the reference state.
+// snap: optional solver with a larger iteration budget. At the smallest step a corrector that hit its iteration
+// limit is retried once with it before the sweep gives up: past a fold (snap-through) the next stable state can be
+// hundreds of Newton iterations away (docs/sweep.md).
 SweepOutcome run_sweep(const NetworkEnergy& e, const SweepParams& p, Solver& solver, const SweepCallbacks& cb,
-                       const SweepState* resume = nullptr);
+                       const SweepState* resume = nullptr, Solver* snap = nullptr);
 
 }  // namespace fibernet
