@@ -11,12 +11,19 @@
 // factorization, mechanics/moduli.hpp) for the seed scheme at n_seg in --nseg and the even scheme at h in --h,
 // against the finest even discretization; writes <out>/discretization.csv (G, relative error, nodes per fiber,
 // DOF, seconds for discretize + modulus).
+// Mode "ratio" (issue 5, part 1): in one process, the first of --solvers (newton) runs to --tol (or its round-off
+// floor) with budget --ref-budget, then every other solver runs from the same start with budget --budget; from each
+// recorded trace, the time at which max|g| first fell to --ratio-tol. Writes <out>/ratio.csv (one row per solver,
+// with t_other / t_ref, a lower bound where the other solver never got there) and <out>/ratio_trace.csv.
 //
-//   bench_solvers [--mode wp|stability] [--out DIR] [--L 4,8,12] [--q 8] [--a 10,100] [--schemes seed,even]
-//                 [--solvers newton,lbfgs,...] [--gamma 0.05] [--tol 1e-10] [--budget 2,4,8] [--seed 1]
-//                 [--max-iter N] [--rel-tol R] [--verbose]
+//   bench_solvers [--mode wp|stability|discretization|ratio] [--out DIR] [--L 4,8,12] [--q 8] [--a 10,100]
+//                 [--schemes seed,even] [--solvers newton,lbfgs,...] [--gamma 0.05] [--tol 1e-10]
+//                 [--budget 2,4,8] [--seed 1] [--max-iter N] [--rel-tol R] [--prune dangling,nonspanning,ends]
+//                 [--ref-budget 1800] [--ratio-tol 1e-6] [--verbose]
 // --rel-tol R > 0 sets each network's tolerance to R * max|g| at its start (the force scale grows like a^2 and
 // gamma, so one absolute tol means different things across the stability grid); otherwise --tol applies.
+// --prune: dangling/nonspanning prune the network (model/prune.hpp), ends trims the load-free end arms
+// (DiscretizationParams::trim_ends); all exact for dry equilibria, so every solver sees a smaller, same problem.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -28,6 +35,7 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -35,6 +43,7 @@
 #include "fibernet/energy/network_energy.hpp"
 #include "fibernet/mechanics/moduli.hpp"
 #include "fibernet/model/discretize.hpp"
+#include "fibernet/model/prune.hpp"
 #include "fibernet/network/mikado.hpp"
 #include "fibernet/solve/solver.hpp"
 #include "fibernet/solve/solver_suite.hpp"
@@ -115,6 +124,38 @@ std::string case_id(const Case& c) {
     return os.str();
 }
 
+struct Pruning {
+    PruneOptions net;
+    bool ends = false;
+};
+
+Pruning parse_prune(const std::string& s) {
+    Pruning p;
+    for (const auto& x : split(s)) {
+        if (x == "dangling") p.net.dangling = true;
+        else if (x == "nonspanning") p.net.nonspanning = true;
+        else if (x == "ends") p.ends = true;
+        else throw std::runtime_error("--prune " + x + " is unknown (expected dangling, nonspanning or ends)");
+    }
+    return p;
+}
+
+// The network of one case, pruned as asked (the same pipeline as scene_network + discretize in the CLI).
+Network make_network(double L, double q, std::uint64_t seed, const Pruning& pr) {
+    MikadoParams mp;
+    mp.L = L, mp.q = q, mp.pl = 1, mp.seed = seed, mp.periodic = true;
+    Network net = generate_mikado(mp);
+    if (pr.net.dangling || pr.net.nonspanning) net = prune(net, pr.net);
+    return net;
+}
+
+// First recorded time at which max|g| <= thr; negative if never.
+double time_to(const std::vector<Sample>& s, double thr) {
+    for (const auto& x : s)
+        if (x.gmax <= thr) return x.t;
+    return -1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -123,6 +164,7 @@ int main(int argc, char** argv) {
         {"a", "10,100"},      {"schemes", "seed,even"}, {"gamma", "0.05"}, {"tol", "1e-10"},
         {"budget", "2,4,8"},  {"seed", "1"},           {"max-iter", "100000000"}, {"verbose", "0"},
         {"solvers", ""},      {"rel-tol", "0"},      {"nseg", "2,3,5,10,20,40"}, {"h", "4,2,1,0.5,0.25,0.125,0.0625"},
+        {"prune", ""},        {"ref-budget", "1800"}, {"ratio-tol", "1e-6"},
     };
     for (int i = 1; i < argc; ++i) {
         std::string k = argv[i];
@@ -158,6 +200,13 @@ int main(int argc, char** argv) {
     const auto budgets = split_d(arg["budget"]);
     const auto schemes = split(arg["schemes"]);
     const std::uint64_t seed = std::stoull(arg["seed"]);
+    Pruning pruning;
+    try {
+        pruning = parse_prune(arg["prune"]);
+    } catch (const std::exception& e) {
+        std::cerr << e.what() << "\n";
+        return 2;
+    }
 
     if (mode == "discretization") {
         std::ofstream os(out + "/discretization.csv");
@@ -166,14 +215,12 @@ int main(int argc, char** argv) {
         for (double L : Ls)
             for (double q : qs)
                 for (double a : as) {
-                    MikadoParams mp;
-                    mp.L = L, mp.q = q, mp.pl = 1, mp.seed = seed, mp.periodic = true;
-                    const Network net = generate_mikado(mp);
+                    const Network net = make_network(L, q, seed, pruning);
                     struct Row { std::string scheme; int n_seg; double h; int nodes, dof; double shortest, G, Ga, td, tm; bool ok; };
                     std::vector<Row> rows;
                     auto run = [&](Scheme sc, int n_seg, double h) {
                         DiscretizationParams dp;
-                        dp.scheme = sc, dp.n_seg = n_seg, dp.h = h, dp.aspect_ratio = a;
+                        dp.scheme = sc, dp.n_seg = n_seg, dp.h = h, dp.aspect_ratio = a, dp.trim_ends = pruning.ends;
                         const auto t0 = std::chrono::steady_clock::now();
                         const Model model = discretize(net, dp);
                         const NetworkEnergy e(model);
@@ -207,6 +254,123 @@ int main(int argc, char** argv) {
         return 0;
     }
 
+    if (mode == "ratio") {
+        std::vector<std::string> names = split(arg["solvers"]);
+        if (names.empty()) names = {"newton", "fire", "lbfgs"};
+        const double ref_budget = std::stod(arg["ref-budget"]), target = std::stod(arg["ratio-tol"]);
+        std::ofstream os(out + "/ratio.csv"), tr(out + "/ratio_trace.csv");
+        os << "case,scheme,L,q,a,gamma,seed,prune,fibers,dof_unpruned,dof,solver,role,status,iterations,evaluations,"
+              "factorizations,seconds,budget_s,tol,energy,rel_energy_err,grad_max,grad_min,target,t_target,t_ref,"
+              "ratio,ratio_is_lower_bound,ratio_same_target,message\n";
+        tr << "case,solver,t,evals,grad_min,energy\n";
+        for (size_t li = 0; li < Ls.size(); ++li)
+            for (double q : qs)
+                for (double a : as)
+                    for (double gamma : gammas)
+                        for (const auto& sc : schemes) {
+                            Case c{Ls[li], q, a, gamma, sc};
+                            const double budget = budgets[std::min(li, budgets.size() - 1)];
+                            DiscretizationParams dp;
+                            dp.scheme = parse_scheme(sc), dp.aspect_ratio = a;
+                            // DOF without pruning, for the record only.
+                            const int dof_full = NetworkEnergy(discretize(make_network(c.L, q, seed, {}), dp)).num_dofs();
+                            dp.trim_ends = pruning.ends;
+                            const Network net = make_network(c.L, q, seed, pruning);
+                            const Model model = discretize(net, dp);
+                            const NetworkEnergy energy(model);
+                            const Eigen::Matrix2d F = deformation(StrainKind::Shear, gamma);
+                            const Eigen::VectorXd q0 =
+                                energy.affine_map(energy.dofs(model.x), Eigen::Matrix2d::Identity(), F);
+                            c.dof = energy.num_dofs();
+                            std::fprintf(stderr, "%s: %zu fibers, %d DOF (%d unpruned), prune '%s'\n", case_id(c).c_str(),
+                                         net.fibers.size(), c.dof, dof_full, arg["prune"].c_str());
+                            std::vector<Run> rs;
+                            for (size_t k = 0; k < names.size(); ++k) {
+                                // The reference runs to --tol; the others only need to reach the target, so they
+                                // stop there (their time to it is the measurement).
+                                SolverOptions opt;
+                                opt.tol = k == 0 ? tol_abs : target, opt.max_iter = max_iter, opt.verbose = verbose;
+                                opt.max_seconds = k == 0 ? ref_budget : budget;
+                                auto solver = make_solver(names[k], opt);
+                                StrainedEnergy obj(energy, F);
+                                Recorder rec(obj);
+                                Eigen::VectorXd x = q0;
+                                Run r;
+                                r.solver = names[k];
+                                try {
+                                    r.res = solver->minimize(rec, x);
+                                } catch (const std::exception& e) {
+                                    r.res.status = SolveStatus::Failed, r.res.solver = names[k];
+                                    r.res.message = std::string("exception: ") + e.what();
+                                    r.res.energy = std::numeric_limits<double>::quiet_NaN();
+                                }
+                                r.samples = std::move(rec.samples);
+                                std::fprintf(stderr, "  %-10s %-16s it %8d  t %8.2fs  E %.15g  max|g| %.2e  %s\n",
+                                             names[k].c_str(), to_string(r.res.status).c_str(), r.res.iterations,
+                                             r.res.timings.total, r.res.energy, r.res.grad_max, r.res.message.c_str());
+                                rs.push_back(std::move(r));
+                            }
+                            double best = std::numeric_limits<double>::infinity();
+                            for (const auto& r : rs) {
+                                for (const auto& x : r.samples) best = std::min(best, x.energy);
+                                if (std::isfinite(r.res.energy)) best = std::min(best, r.res.energy);
+                            }
+                            const double scale = std::max(std::abs(best), 1e-300);
+                            // Newton's time is that of its converged return (to tol, or at its round-off floor,
+                            // which the message states); no ratio without a converged reference.
+                            const Run& ref = rs[0];
+                            const double t_ref = ref.res.converged() ? ref.res.timings.total : -1;
+                            const double t_ref_target = time_to(ref.samples, target);
+                            for (size_t k = 0; k < rs.size(); ++k) {
+                                const Run& r = rs[k];
+                                double gmin = std::numeric_limits<double>::infinity();
+                                for (const auto& x : r.samples) gmin = std::min(gmin, x.gmax);
+                                const double tt = time_to(r.samples, target);
+                                // Never reached: the target lies beyond the time the run took, so the ratio is at
+                                // least that time over Newton's.
+                                const bool lower = tt < 0;
+                                const double t_other = lower ? r.res.timings.total : tt;
+                                std::string ratio = "", same = "";
+                                if (k > 0 && t_ref > 0) ratio = std::to_string(t_other / t_ref);
+                                if (k > 0 && t_ref_target > 0) same = std::to_string(t_other / t_ref_target);
+                                std::string msg = r.res.message;
+                                std::replace(msg.begin(), msg.end(), ',', ';');
+                                std::replace(msg.begin(), msg.end(), '"', '\'');
+                                os << case_id(c) << "," << sc << "," << c.L << "," << q << "," << a << "," << gamma
+                                   << "," << seed << ",\"" << arg["prune"] << "\"," << net.fibers.size() << ","
+                                   << dof_full << "," << c.dof << "," << r.solver << "," << (k == 0 ? "ref" : "other")
+                                   << "," << to_string(r.res.status) << "," << r.res.iterations << ","
+                                   << r.res.evaluations << "," << r.res.factorizations << "," << r.res.timings.total
+                                   << "," << (k == 0 ? ref_budget : budget) << "," << (k == 0 ? tol_abs : target)
+                                   << "," << std::setprecision(17) << r.res.energy << "," << std::setprecision(6)
+                                   << (r.res.energy - best) / scale << "," << r.res.grad_max << "," << gmin << ","
+                                   << target << "," << (tt < 0 ? std::string("") : std::to_string(tt)) << ","
+                                   << t_ref << "," << ratio << "," << (k > 0 && lower ? 1 : 0) << "," << same
+                                   << ",\"" << msg << "\"\n";
+                                if (k > 0)
+                                    std::fprintf(stderr, "  %s: t(max|g| <= %g) %s, ratio to newton %s%s\n",
+                                                 r.solver.c_str(), target,
+                                                 lower ? "not reached" : std::to_string(tt).c_str(),
+                                                 lower ? ">= " : "", ratio.c_str());
+                                // Running minimum of max|g|, thinned to drops of >= 2% (plus the first and last).
+                                double gm = std::numeric_limits<double>::infinity(), gl = gm;
+                                for (size_t i = 0; i < r.samples.size(); ++i) {
+                                    const auto& x = r.samples[i];
+                                    gm = std::min(gm, x.gmax);
+                                    if (i == 0 || i + 1 == r.samples.size() || gm < 0.98 * gl) {
+                                        tr << case_id(c) << "," << r.solver << "," << std::setprecision(6) << x.t
+                                           << "," << x.evals << "," << gm << "," << std::setprecision(17) << x.energy
+                                           << "\n";
+                                        gl = gm;
+                                    }
+                                }
+                            }
+                            os.flush();
+                            tr.flush();
+                        }
+        return 0;
+    }
+
     std::vector<std::pair<Case, double>> cases;  // with the time budget per run
     for (size_t li = 0; li < Ls.size(); ++li)
         for (double q : qs)
@@ -225,11 +389,9 @@ int main(int argc, char** argv) {
         trace << "case,scheme,L,a,dof,solver,t,evals,grad_min,rel_energy_err\n";
     }
     for (auto& [c, budget] : cases) {
-        MikadoParams mp;
-        mp.L = c.L, mp.q = c.q, mp.pl = 1, mp.seed = seed, mp.periodic = true;
         DiscretizationParams dp;
-        dp.scheme = parse_scheme(c.scheme), dp.aspect_ratio = c.a;
-        const Model model = discretize(generate_mikado(mp), dp);
+        dp.scheme = parse_scheme(c.scheme), dp.aspect_ratio = c.a, dp.trim_ends = pruning.ends;
+        const Model model = discretize(make_network(c.L, c.q, seed, pruning), dp);
         const NetworkEnergy energy(model);
         const Eigen::Matrix2d F = deformation(StrainKind::Shear, c.gamma);
         const Eigen::VectorXd q0 = energy.affine_map(energy.dofs(model.x), Eigen::Matrix2d::Identity(), F);
