@@ -1,7 +1,11 @@
 // fibernet wet: dry network -> relax -> wet -> relax under capillary load (issue 6). JSON summary on stdout; with
 // -o DIR also summary.json, sweep.csv, pores.csv, network.svg (dry | wet) and pores.svg (pore-size distributions).
-// Exit 1 when a relaxation did not reach a stable equilibrium (results still reported, marked).
+// With --free-box (or [wet] free_box = true) each beta's wet state is then taken to its zero-stress box (drying
+// shrinkage; docs/wet.md, "Free box"), one progress line per outer iteration on stderr.
+// Exit 1 when a relaxation did not reach a stable equilibrium or the free box did not converge (results still
+// reported, marked).
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "common.hpp"
@@ -30,6 +34,72 @@ nlohmann::json pore_json(const PoreStats& p) {
 nlohmann::json energy_json(const WetSplit& e) {
     return {{"total", e.total()}, {"stretch", e.stretch}, {"bend", e.bend}, {"capillary", e.capillary}};
 }
+
+nlohmann::json matrix_json(const Eigen::Matrix2d& M) {
+    return nlohmann::json::array({nlohmann::json::array({M(0, 0), M(0, 1)}), nlohmann::json::array({M(1, 0), M(1, 1)})});
+}
+
+nlohmann::json stress_json(const Stress& s, double sc) {
+    const double xy = 0.5 * (s.sigma(0, 1) + s.sigma(1, 0));
+    return {{"sigma", {{"xx", s.sigma(0, 0)}, {"yy", s.sigma(1, 1)}, {"xy", xy}}},
+            {"relative", {{"xx", s.sigma(0, 0) / sc}, {"yy", s.sigma(1, 1) / sc}, {"xy", xy / sc},
+                          {"mean_normal", 0.5 * (s.sigma(0, 0) + s.sigma(1, 1)) / sc}}},
+            {"area", s.area}};
+}
+
+nlohmann::json free_box_json(const FreeBoxResult& f, const FreeBoxOptions& o) {
+    nlohmann::json j = {{"attempted", f.attempted},
+                        {"converged", f.converged},
+                        {"message", f.message},
+                        {"shape", o.isotropic ? "isotropic" : "full"},
+                        {"controlled", o.isotropic ? "mean normal stress" : "sigma_xx, sigma_yy, sigma_xy"},
+                        {"tol", o.tol}};
+    if (!f.attempted) return j;
+    nlohmann::json hist = nlohmann::json::array();
+    for (const auto& it : f.history)
+        hist.push_back({{"iteration", it.iteration}, {"F", matrix_json(it.F)},
+                        {"sigma_relative", {it.sigma[0], it.sigma[1], it.sigma[2]}}, {"residual", it.residual},
+                        {"energy", it.energy}, {"step", it.step}, {"trials", it.trials}, {"rounds", it.relax_rounds},
+                        {"solver_iterations", it.solver_iterations}, {"seconds", it.seconds}});
+    nlohmann::json eig = nlohmann::json::array();
+    for (int k = 0; k < f.stiffness_eigenvalues.size(); ++k) eig.push_back(f.stiffness_eigenvalues[k]);
+    // Stable: no eigenvalue below -1e-6 sigma_c (round-off of the finite differences, well below any real mode).
+    const bool stable = f.stiffness_eigenvalues.size() && f.stiffness_eigenvalues.minCoeff() >= -1e-6 * f.stress_scale;
+    nlohmann::json bh = nlohmann::json::object();
+    for (const auto& [size, count] : f.bundles.histogram) bh[std::to_string(size)] = count;
+    j.update({{"F0", matrix_json(f.F0)},
+              {"F", matrix_json(f.F)},
+              {"s", f.s},
+              {"det_ratio", f.F.determinant() / f.F0.determinant()},
+              {"areal_shrinkage", f.areal_shrinkage},
+              {"stress_scale", f.stress_scale},
+              {"stress_fixed_box", stress_json(f.stress0, f.stress_scale)},
+              {"stress", stress_json(f.stress, f.stress_scale)},
+              {"bracketed", f.bracketed},
+              {"snap", f.snap ? nlohmann::json({{"s", {f.snap_s[0], f.snap_s[1]}},
+                                                {"residual", {f.snap_residual[0], f.snap_residual[1]}}})
+                              : nlohmann::json()},
+              {"residual_fixed_box", f.residual0},
+              {"residual", f.residual},
+              {"stiffness_eigenvalues", eig},
+              {"stable", f.stiffness_eigenvalues.size() ? nlohmann::json(stable) : nlohmann::json()},
+              {"iterations", f.iterations},
+              {"relaxations", f.relaxations},
+              {"stiffness_solves", f.stiffness_solves},
+              {"solver_iterations", f.solver_iterations},
+              {"energy", energy_json(f.energy)},
+              {"bridges", f.bridges.size()},
+              {"events",
+               {{"moves", f.events.moves}, {"ruptures", f.events.ruptures}, {"formed", f.events.formed},
+                {"merged", f.events.merged}, {"locked", f.events.locked}}},
+              {"pores", pore_json(f.pores)},
+              {"bundles",
+               {{"bundled_fibers", f.bundles.bundled_fibers}, {"count", f.bundles.sizes.size()},
+                {"largest", f.bundles.sizes.empty() ? 1 : f.bundles.sizes.front()}, {"size_histogram", bh}}},
+              {"history", hist},
+              {"seconds", f.seconds}});
+    return j;
+}
 }  // namespace
 
 void register_wet(CLI::App& app) {
@@ -41,7 +111,9 @@ void register_wet(CLI::App& app) {
         std::vector<double> betas;
         std::string law, crossings, out;
         std::uint64_t seed = 0;
-        bool no_moduli = false, verbose = false;
+        bool no_moduli = false, verbose = false, free_box = false;
+        std::string free_box_shape;
+        double free_box_tol = 0;
     };
     auto w = std::make_shared<WetFlags>();
     auto* o_beta = cmd->add_option("--beta", w->beta, "adhesion per unit bundle length, bending units (default 1)");
@@ -52,6 +124,13 @@ void register_wet(CLI::App& app) {
     auto* o_ws = cmd->add_option("--wet-seed", w->seed, "seed of the wet fraction draw");
     cmd->add_option("-o,--out-dir", w->out, "write summary.json, sweep.csv, pores.csv, network.svg, pores.svg here");
     cmd->add_flag("--no-moduli", w->no_moduli, "skip the dry and wet shear moduli");
+    auto* o_fb = cmd->add_flag("--free-box", w->free_box,
+                               "then find the zero-stress box of the wet network (drying shrinkage, docs/wet.md)");
+    auto* o_fbs = cmd->add_option("--free-box-shape", w->free_box_shape,
+                                  "isotropic (F = s F0, mean normal stress -> 0; default) | full (symmetric box "
+                                  "stretch, sigma_xx, sigma_yy, sigma_xy -> 0; less robust, docs/wet.md)");
+    auto* o_fbt = cmd->add_option("--free-box-tol", w->free_box_tol,
+                                  "free box converged at |sigma| <= tol * sigma_c (default 1e-3)");
     cmd->add_flag("-v,--verbose", w->verbose, "solver progress on stderr");
     cmd->callback([=] {
         const auto t_all = std::chrono::steady_clock::now();
@@ -63,6 +142,9 @@ void register_wet(CLI::App& app) {
         if (o_cr->count()) s.wet.crossings = w->crossings;
         if (o_fr->count()) s.wet.fraction = w->fraction;
         if (o_ws->count()) s.wet.seed = w->seed;
+        if (o_fb->count()) s.wet.free_box = w->free_box;
+        if (o_fbs->count()) s.wet.free_box_shape = w->free_box_shape;
+        if (o_fbt->count()) s.wet.free_box_tol = w->free_box_tol;
         s.source = flags->scene_file.empty() ? "command line" : flags->scene_file + " + command line";
         s.check();
         std::vector<double> betas = w->betas.empty() ? std::vector<double>{s.wet.beta} : w->betas;
@@ -77,8 +159,17 @@ void register_wet(CLI::App& app) {
         opt.solver_options.verbose = w->verbose;
         opt.moduli = !w->no_moduli;
         make_solver(opt.solver, opt.solver_options);  // an unknown solver is an InputError before any work
+        if (!s.wet.free_box && (o_fbs->count() || o_fbt->count()))
+            throw InputError(std::string(o_fbs->count() ? "--free-box-shape" : "--free-box-tol") +
+                             " given without --free-box (or [wet] free_box = true)");
+        opt.free_box.enabled = s.wet.free_box;
+        opt.free_box.isotropic = s.wet.free_box_shape == "isotropic";
+        opt.free_box.tol = s.wet.free_box_tol;
+        opt.free_box.progress = true;
 
         const Network net = scene_network(s);
+        if (s.wet.free_box && !net.periodic)
+            throw InputError(s.source + ": the free box needs a periodic network (an open network has no box stress)");
         const Model m = discretize(net, s.discretization);
         const Eigen::Matrix2d F = deformation(s.strain, s.gamma);
         const Eigen::Matrix2d B = F * m.box.B0();
@@ -86,7 +177,9 @@ void register_wet(CLI::App& app) {
         nlohmann::json runs = nlohmann::json::array();
         std::ostringstream sweep, pore_csv;
         sweep << "beta,status,bridges,moves,ruptures,formed,merged,rounds,E_stretch,E_bend,E_capillary,pores,mean_pore_area,"
-                 "mean_pore_diameter,bundled_fibers,largest_bundle,G_dry,G_wet\n";
+                 "mean_pore_diameter,bundled_fibers,largest_bundle,G_dry,G_wet";
+        if (opt.free_box.enabled) sweep << ",free_box,s,areal_shrinkage,free_box_residual,free_box_iterations";
+        sweep << "\n";
         pore_csv << "state,beta,area,diameter\n";
         sweep.precision(10), pore_csv.precision(10);
         bool ok = true, dry_written = false;
@@ -96,21 +189,28 @@ void register_wet(CLI::App& app) {
         std::vector<std::vector<double>> hist_values;
         for (size_t k = 0; k < betas.size(); ++k) {
             opt.params.beta = betas[k];
+            if (opt.free_box.enabled) std::fprintf(stderr, "wet: beta = %g\n", betas[k]);  // heads the progress lines
             const WetRun r = run_wet(net, m, F, opt, k == 0 ? nullptr : &dry_state);
             if (k == 0) dry_state = r.dry;
-            const bool good = r.dry.converged && r.wet.converged && r.active.stable;
+            const bool wet_good = r.dry.converged && r.wet.converged && r.active.stable;
+            const bool good = wet_good && (!opt.free_box.enabled || r.free_box.converged);
+            const char* bad = !wet_good ? "not_stable" : "free_box_not_converged";
             ok = ok && good;
             const auto& pw = r.wet.pores.pores;
             double sum = 0, dsum = 0;
             for (const auto& p : pw) sum += p.area, dsum += p.diameter;
             const int largest = r.bundles.sizes.empty() ? 1 : r.bundles.sizes.front();
-            sweep << betas[k] << "," << (good ? "ok" : "not_stable") << "," << r.active.bridges.size() << ","
+            sweep << betas[k] << "," << (good ? "ok" : bad) << "," << r.active.bridges.size() << ","
                   << r.active.events.moves << "," << r.active.events.ruptures << "," << r.active.events.formed << ","
                   << r.active.events.merged << "," << r.active.rounds << "," << r.wet.energy.stretch << ","
                   << r.wet.energy.bend << "," << r.wet.energy.capillary << "," << pw.size() << ","
                   << (pw.empty() ? 0 : sum / pw.size()) << "," << (pw.empty() ? 0 : dsum / pw.size()) << ","
                   << r.bundles.bundled_fibers << "," << largest << "," << dry_state.shear_modulus << ","
-                  << r.wet.shear_modulus << "\n";
+                  << r.wet.shear_modulus;
+            if (opt.free_box.enabled)
+                sweep << "," << (r.free_box.converged ? "converged" : "not_converged") << "," << r.free_box.s << ","
+                      << r.free_box.areal_shrinkage << "," << r.free_box.residual << "," << r.free_box.iterations;
+            sweep << "\n";
             if (!dry_written) {
                 for (const auto& p : r.dry.pores.pores) pore_csv << "dry,0," << p.area << "," << p.diameter << "\n";
                 std::vector<double> d;
@@ -126,18 +226,36 @@ void register_wet(CLI::App& app) {
             std::ostringstream name;
             name << "wet, beta = " << betas[k];
             hist_names.push_back(name.str()), hist_values.push_back(d);
+            if (r.free_box.attempted) {
+                std::vector<double> fd;
+                for (const auto& p : r.free_box.pores.pores) {
+                    pore_csv << "free_box," << betas[k] << "," << p.area << "," << p.diameter << "\n";
+                    fd.push_back(p.diameter);
+                }
+                hist_names.push_back(name.str() + ", free box"), hist_values.push_back(fd);
+            }
             if (k + 1 == betas.size()) {
                 NetworkEnergy e(m);
                 std::vector<int> size(m.chains.size(), 0);
                 for (int lab : r.bundles.bundle_of_fiber) ++size[lab];
                 panels.push_back({name.str() + " (bridges red, bundles coloured)", e.positions(r.wet.q, F), B,
                                   r.active.bridges, r.bundles.bundle_of_fiber, size});
+                if (r.free_box.attempted) {
+                    std::vector<int> fsize(m.chains.size(), 0);
+                    for (int lab : r.free_box.bundles.bundle_of_fiber) ++fsize[lab];
+                    std::ostringstream fname;
+                    fname << name.str() << ", free box (" << (r.free_box.converged ? "" : "NOT converged, ")
+                          << "areal shrinkage " << r.free_box.areal_shrinkage << ")";
+                    panels.push_back({fname.str(), e.positions(r.free_box.q, r.free_box.F),
+                                      r.free_box.F * m.box.B0(), r.free_box.bridges, r.free_box.bundles.bundle_of_fiber,
+                                      fsize});
+                }
             }
             nlohmann::json hist = nlohmann::json::object();
             for (const auto& [size, count] : r.bundles.histogram) hist[std::to_string(size)] = count;
             runs.push_back(
                 {{"beta", betas[k]},
-                 {"status", good ? "stable" : "not_stable"},
+                 {"status", good ? "stable" : bad},
                  {"message", r.active.message},
                  {"energy", {{"dry", energy_json(r.dry.energy)}, {"wet", energy_json(r.wet.energy)}}},
                  {"bridges", {{"initial", r.initial_bridges.size()}, {"final", r.active.bridges.size()}}},
@@ -151,6 +269,7 @@ void register_wet(CLI::App& app) {
                  {"pores", {{"dry", pore_json(r.dry.pores)}, {"wet", pore_json(r.wet.pores)}}},
                  {"shear_modulus", {{"dry", num(dry_state.shear_modulus)}, {"wet", num(r.wet.shear_modulus)}}},
                  {"solver", solve_json(r.active.last, s.solver.tol)},
+                 {"free_box", opt.free_box.enabled ? free_box_json(r.free_box, opt.free_box) : nlohmann::json()},
                  {"solver_iterations", r.active.solver_iterations},
                  {"seconds",
                   {{"dry", r.seconds_dry}, {"wet_solve", r.seconds_wet_solve}, {"events", r.seconds_events},
@@ -162,7 +281,8 @@ void register_wet(CLI::App& app) {
                             {"wet",
                              {{"law", s.wet.law.empty() ? "cos2" : s.wet.law},
                               {"crossings", s.wet.crossings},
-                              {"fraction", s.wet.fraction}}},
+                              {"fraction", s.wet.fraction},
+                              {"free_box", s.wet.free_box}}},
                             {"gamma", s.gamma},
                             {"runs", runs},
                             {"seconds", seconds_since(t_all)}};

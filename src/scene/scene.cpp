@@ -21,6 +21,10 @@ void Scene::check() const {
     check_value(wet.fraction >= 0 && wet.fraction <= 1, wet.fraction, source, "[wet].fraction", "must lie in [0, 1]");
     if (wet.crossings != "all" && wet.crossings != "free" && wet.crossings != "fraction")
         throw InputError(source + ": [wet].crossings = '" + wet.crossings + "' is unknown (expected all, free or fraction)");
+    check_value(wet.free_box_tol > 0, wet.free_box_tol, source, "[wet].free_box_tol", "must be > 0");
+    if (wet.free_box_shape != "full" && wet.free_box_shape != "isotropic")
+        throw InputError(source + ": [wet].free_box_shape = '" + wet.free_box_shape +
+                         "' is unknown (expected isotropic or full)");
     if (!wet.law.empty()) {
         try {
             CapillaryLaw::read(wet.law);  // a malformed table names its file and row
@@ -166,6 +170,9 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         r.get("crossings", s.wet.crossings);
         r.get("fraction", s.wet.fraction);
         r.get_seed("seed", s.wet.seed);
+        r.get("free_box", s.wet.free_box);
+        r.get("free_box_shape", s.wet.free_box_shape);
+        r.get("free_box_tol", s.wet.free_box_tol);
         r.finish();
     }
     s.check();

@@ -42,10 +42,37 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
                           Case{"--crossings fraction --fraction 2", "fraction = 2"},
                           Case{"--crossings some", "some"}, Case{"--law " + law, "100"},
                           Case{"--law " + unsorted, "30"}, Case{scene, "fraction = 1.5"},
-                          Case{"--prune ends", "prune \"ends\" is not valid for `fibernet wet`"}}) {
+                          Case{"--prune ends", "prune \"ends\" is not valid for `fibernet wet`"},
+                          Case{"--free-box --open", "periodic"}, Case{"--free-box --free-box-shape round", "round"},
+                          Case{"--free-box --free-box-tol 0", "free_box_tol = 0"},
+                          Case{"--free-box --free-box-tol nan", "free_box_tol = nan"},
+                          Case{"--free-box-tol 1e-3", "--free-box-tol given without --free-box"},
+                          Case{"--free-box-shape full", "--free-box-shape given without --free-box"}}) {
         INFO(c.args);
         CHECK(run("--L 2.5 --q 5 " + c.args + " -o " + out) == 2);
         CHECK(slurp(tmpdir() + "/stderr").find(c.needle) != std::string::npos);
         CHECK(!exists(out + "/summary.json"));
     }
+}
+
+TEST_CASE("cli wet: --free-box reports the zero-stress box, and exit 1 when it is not found", "[wet][cli][free_box]") {
+    const std::string out = tmpdir() + "/free";
+    REQUIRE(std::system(("mkdir -p " + out).c_str()) == 0);
+    // beta = 0 on a rigid network strained by 2 %: the free box goes back to the reference, s = 1 / 1.02.
+    const std::string net = "--L 2.5 --q 10 --pl 1 --seed 4 --beta 0 --no-moduli --strain isotropic --gamma 0.02 --free-box";
+    REQUIRE(run(net + " --free-box-tol 1e-6 -o " + out) == 0);
+    const std::string j = slurp(out + "/summary.json");
+    for (const char* key : {"\"free_box\"", "\"areal_shrinkage\"", "\"residual\"", "\"iterations\"", "\"converged\": true",
+                            "\"stiffness_eigenvalues\"", "\"shape\": \"isotropic\""})
+        CHECK(j.find(key) != std::string::npos);
+    const std::string csv = slurp(out + "/sweep.csv");
+    CHECK(csv.find(",free_box,s,areal_shrinkage,free_box_residual,free_box_iterations") != std::string::npos);
+    CHECK(csv.find(",converged,0.98039") != std::string::npos);  // s = 1 / 1.02 = 0.980392...
+    CHECK(slurp(tmpdir() + "/stderr").find("free box iter") != std::string::npos);  // progress per iteration
+    CHECK(slurp(out + "/pores.csv").find("free_box,0,") != std::string::npos);
+    // A tolerance below round-off cannot be met: not converged, exit 1, and the JSON says so.
+    CHECK(run(net + " --free-box-tol 1e-300") == 1);
+    const std::string k = slurp(tmpdir() + "/stdout");
+    CHECK(k.find("\"converged\": false") != std::string::npos);
+    CHECK(k.find("\"status\": \"free_box_not_converged\"") != std::string::npos);
 }

@@ -14,6 +14,12 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
     CHECK(s.wet.fraction == 0.25);
     CHECK(s.wet.seed == 7);
     CHECK(parse_scene("", "empty.toml").wet.crossings == "all");
+    CHECK(!parse_scene("", "empty.toml").wet.free_box);
+    CHECK(parse_scene("", "empty.toml").wet.free_box_shape == "isotropic");
+    const Scene f = parse_scene("[wet]\nfree_box = true\nfree_box_shape = \"full\"\nfree_box_tol = 1e-4\n", "f.toml");
+    CHECK(f.wet.free_box);
+    CHECK(f.wet.free_box_shape == "full");
+    CHECK(f.wet.free_box_tol == 1e-4);
     struct Bad {
         std::string toml, needle;
     };
@@ -21,6 +27,9 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
                          Bad{"[wet]\nfraction = 1.5\n", "[wet].fraction = 1.5"},
                          Bad{"[wet]\ncrossings = \"most\"\n", "most"}, Bad{"[wet]\nbeta = \"big\"\n", "[wet].beta"},
                          Bad{"[wet]\nwetness = 1\n", "wetness"},
+                         Bad{"[wet]\nfree_box = 1\n", "[wet].free_box"},
+                         Bad{"[wet]\nfree_box_shape = \"round\"\n", "[wet].free_box_shape = 'round'"},
+                         Bad{"[wet]\nfree_box_tol = -1\n", "[wet].free_box_tol = -1"},
                          Bad{"[wet]\nlaw = \"/nonexistent/law.txt\"\n", "/nonexistent/law.txt"}}) {
         INFO(b.toml);
         try {

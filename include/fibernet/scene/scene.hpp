@@ -26,6 +26,9 @@ struct WetSettings {
     std::string crossings = "all";  // which crossings are wet: all | free | fraction
     double fraction = 1;        // crossings = "fraction": probability that a crossing is wet, in [0, 1]
     std::uint64_t seed = 1;     // draws of the wet fraction
+    bool free_box = false;      // after the fixed-box relaxation, find the zero-stress box (docs/wet.md, "Free box")
+    std::string free_box_shape = "isotropic";  // isotropic (F = s F0) | full (symmetric U, 3 unknowns)
+    double free_box_tol = 1e-3;           // |sigma| / sigma_c below which the free box has converged, > 0
 };
 
 struct Scene {
