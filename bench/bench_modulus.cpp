@@ -82,6 +82,9 @@ int main(int argc, char** argv) {
     opt.max_iter = 500;
     NewtonSolver newton(opt);
     const Equilibrium eq0 = relax(e, I, newton);
+    // The symbolic analysis is once per model (t_analyze); the modulus reuses it, as `fibernet modulus` reuses
+    // Newton's. (relax at F = I returns the rest state without a solve, so nothing has analyzed the pattern yet.)
+    newton.factorization_for(e.hessian_pattern());
     t = Clock::now();
     ModuliInfo info;
     const auto mods = linear_moduli(e, eq0.q, I, {shear_mode(I, m.box.area()), bulk_mode(I, m.box.area())}, {}, &info,
