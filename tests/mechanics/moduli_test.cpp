@@ -50,6 +50,23 @@ Linear moduli_at(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::
     return {m[0].value, m[1].value, m[0].affine, m[0].ok && m[1].ok, m[0].error, m[1].error};
 }
 
+// Positions of a reduced model (pruned fibers, trimmed arms) taken from the full model's positions xf: fiber i of
+// `part` is fiber kept[i] of `full` (kept empty: the same index), and its chain is a contiguous run of the full
+// chain starting where the arc positions match. Node-for-node equal because pruning keeps breakpoints.
+Eigen::VectorXd restrict_positions(const Model& full, const Model& part, const Eigen::VectorXd& xf,
+                                   const std::vector<int>& kept = {}) {
+    Eigen::VectorXd xp = part.x;
+    for (size_t i = 0; i < part.chains.size(); ++i) {
+        const FiberChain &cf = full.chains[kept.empty() ? i : kept[i]], &cp = part.chains[i];
+        if (cp.nodes.empty()) continue;
+        size_t k0 = 0;
+        while (k0 < cf.s.size() && cf.s[k0] != cp.s.front()) ++k0;
+        REQUIRE(k0 + cp.s.size() <= cf.s.size());
+        for (size_t k = 0; k < cp.nodes.size(); ++k) xp.segment<2>(2 * cp.nodes[k]) = xf.segment<2>(2 * cf.nodes[k0 + k]);
+    }
+    return xp;
+}
+
 }  // namespace
 
 TEST_CASE("G equals the central-difference slope of sigma_xy from nonlinear solves", "[moduli][fd]") {
@@ -163,14 +180,8 @@ TEST_CASE("pruning dangling fibers and non-spanning clusters changes neither G n
             // The full equilibrium restricted to the kept fibers (their chains are node-for-node the same, since
             // pruning keeps breakpoints): it must be an equilibrium of the pruned model with the same G, K, stress
             // and energy. (Solving the pruned model from scratch may land in another buckled minimum at 1% shear.)
-            const Eigen::VectorXd xf = ef.positions(a.q, F);
-            Eigen::VectorXd xp = pruned.x;
-            for (size_t i = 0; i < kept.size(); ++i) {
-                const auto& nf = full.chains[kept[i]].nodes;
-                const auto& np = pruned.chains[i].nodes;
-                REQUIRE(nf.size() == np.size());
-                for (size_t k = 0; k < nf.size(); ++k) xp.segment<2>(2 * np[k]) = xf.segment<2>(2 * nf[k]);
-            }
+            for (size_t i = 0; i < kept.size(); ++i) REQUIRE(full.chains[kept[i]].nodes.size() == pruned.chains[i].nodes.size());
+            const Eigen::VectorXd xp = restrict_positions(full, pruned, ef.positions(a.q, F), kept);
             // Positions are wrapped per model; a node of the pruned model may sit at another image only if the
             // two models wrap it differently, which they do not (same fibers, same reference positions).
             const Eigen::VectorXd qp = ep.dofs(xp);
@@ -216,16 +227,7 @@ TEST_CASE("trimming end arms changes neither the equilibrium nor G and K", "[mod
             REQUIRE(a.converged());
             // The full equilibrium restricted to the trimmed chains (contiguous runs of the full ones) must be an
             // equilibrium of the trimmed model with the same energy, stress, G and K: the arms carried nothing.
-            const Eigen::VectorXd xf = ef.positions(a.q, F);
-            Eigen::VectorXd xt = trimmed.x;
-            for (size_t f = 0; f < full.chains.size(); ++f) {
-                const FiberChain &cf = full.chains[f], &ct = trimmed.chains[f];
-                if (ct.nodes.empty()) continue;
-                size_t k0 = 0;
-                while (k0 < cf.s.size() && cf.s[k0] != ct.s.front()) ++k0;
-                REQUIRE(k0 + ct.s.size() <= cf.s.size());
-                for (size_t k = 0; k < ct.nodes.size(); ++k) xt.segment<2>(2 * ct.nodes[k]) = xf.segment<2>(2 * cf.nodes[k0 + k]);
-            }
+            const Eigen::VectorXd xt = restrict_positions(full, trimmed, ef.positions(a.q, F));
             const Eigen::VectorXd qt = et.dofs(xt);
             EnergyEval evt;
             et.evaluate(qt, F, Eigen::Matrix2d::Zero(), kGradient, evt);
