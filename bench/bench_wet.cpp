@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 
 #include "fibernet/model/discretize.hpp"
 #include "fibernet/network/mikado.hpp"
@@ -19,12 +20,16 @@ int main(int argc, char** argv) {
     const double beta = argc > 3 ? std::atof(argv[3]) : 0.01;
     const int rounds = argc > 4 ? std::atoi(argv[4]) : 30;
     const int max_iter = argc > 5 ? std::atoi(argv[5]) : 500;
+    const std::string scheme = argc > 6 ? argv[6] : "seed";
+    const unsigned seed = argc > 7 ? static_cast<unsigned>(std::atoi(argv[7])) : 1u;
     const auto t0 = std::chrono::steady_clock::now();
     MikadoParams mp;
-    mp.q = q, mp.pl = 0.5, mp.seed = 1;
+    mp.q = q, mp.pl = 0.5, mp.seed = seed;
     mp.L = std::sqrt(N / q);  // N = q L^2 (fiber lengths)
     const Network net = generate_mikado(mp);
-    const Model m = discretize(net, DiscretizationParams{});
+    DiscretizationParams dp;
+    dp.scheme = parse_scheme(scheme);
+    const Model m = discretize(net, dp);
     const double t_build = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     WetRunOptions opt;
     opt.params.beta = beta;

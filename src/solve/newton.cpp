@@ -52,6 +52,8 @@ constexpr double kMuFloor = 1e-13;    // relative to mean diag: round-off scale 
 constexpr double kMuStart = 1e-8;     // relative to mean diag: first Levenberg-Marquardt shift
 constexpr double kLambda0 = 1e-8;     // rung 2 start, relative to mean diag
 constexpr int kLambdaSteps = 11;
+constexpr double kExactGrow = 4;      // rung 0 escalation factor
+constexpr double kExactCap = 0.2;     // rung 0 escalation stops above this x mean diag
 constexpr int kMaxHalvings = 60;
 }  // namespace
 
@@ -172,7 +174,26 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
             ++r.evaluations;
             projected = true;
         };
-        if (start_rung <= 0 && try_factor(mu)) rung = 0, shift = mu;
+        if (start_rung <= 0) {
+            if (try_factor(mu)) {
+                rung = 0, shift = mu;
+            } else {
+                // Exact H + lambda I with lambda raised 4x at a time (Nocedal & Wright, Alg. 3.3) before giving up
+                // the exact Hessian: negative curvature (capillary torques, buckling) is kept in every direction but
+                // the few unstable ones, where projecting each element's block would overstate the stiffness of the
+                // whole assembly and turn Newton into a linearly converging method (docs/moduli.md, "Newton ladder").
+                if (projected) {
+                    auto ta = Clock::now();
+                    f.hessian(q, gt, H, false);
+                    r.timings.assembly += since(ta);
+                    ++r.evaluations;
+                    projected = false;
+                }
+                double lam = std::max(kExactGrow * mu, kLambda0 * dm);
+                for (; lam <= kExactCap * dm && rung < 0; lam *= kExactGrow)
+                    if (try_factor(lam)) rung = 0, shift = lam;
+            }
+        }
         if (rung < 0 && start_rung <= 1) {
             make_projected();
             if (try_factor(mu)) rung = 1, shift = mu;

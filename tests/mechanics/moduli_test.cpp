@@ -195,7 +195,8 @@ TEST_CASE("pruning dangling fibers and non-spanning clusters changes neither G n
             REQUIRE(lb.ok);
             REQUIRE(la.G > 1e-6 * la.G_aff);  // a rigid network: the comparison is not 0 == 0
             INFO("seed " << seed << " h " << h << " gamma " << gamma << ": G " << la.G << " vs " << lb.G << ", K "
-                         << la.K << " vs " << lb.K);
+                         << la.K << " vs " << lb.K << " Gerr " << la.G_err << " " << lb.G_err << " gmax " << a.result.grad_max
+                         << " its " << a.result.iterations << " msg " << a.result.message);
             // Agreement to 1e-6 plus the solves' own error bounds (measured: <= 2.7e-7 relative; the unpruned model's
             // floppy dangling fibers slow its conjugate gradients). Without breakpoints it was 1e-4 at h = 1.
             CHECK(std::abs(lb.G - la.G) <= 1e-6 * std::abs(la.G) + la.G_err + lb.G_err);

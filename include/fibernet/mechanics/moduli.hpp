@@ -41,6 +41,7 @@ struct Modulus {
     double E_tt = 0, correction = 0;  // unscaled affine (comoving) part and non-affine correction at the equilibrium
     double error = 0;       // bound on |value error| from the refinement (scaled)
     int refinements = 0;        // conjugate-gradient steps
+    bool stalled = false;       // round-off stopped the conjugate gradients before they converged
     Eigen::VectorXd response;   // a solution of H r = E_xt: dq/dt = -response along the mode
     bool ok = false;        // false: H + delta I could not be factored or the refinement did not converge
 };
