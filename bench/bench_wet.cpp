@@ -1,7 +1,7 @@
 // Wet relaxation benchmark (issue 6, "Performance"): a Mikado network of N fibers (density q, pl = 0.5, seed
 // scheme) relaxed dry, wetted at all crossings and relaxed under capillary load with mobile bridges.
 // Prints one JSON line per run with the time split: dry Newton, wet Newton, event handling, pore analysis.
-//   bench_wet [N=1000] [q=10] [beta=0.01] [max_rounds=30] [newton_max_iter=500]
+//   bench_wet [N=1000] [q=10] [beta=0.01] [max_rounds=30] [newton_max_iter=500] [scheme=seed] [seed=1] [move_margin=0.1]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
     const int max_iter = argc > 5 ? std::atoi(argv[5]) : 500;
     const std::string scheme = argc > 6 ? argv[6] : "seed";
     const unsigned seed = argc > 7 ? static_cast<unsigned>(std::atoi(argv[7])) : 1u;
+    const double move_margin = argc > 8 ? std::atof(argv[8]) : ActiveSetOptions{}.move_margin;
     const auto t0 = std::chrono::steady_clock::now();
     MikadoParams mp;
     mp.q = q, mp.pl = 0.5, mp.seed = seed;
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
     opt.params.beta = beta;
     opt.moduli = false;
     opt.active_set.max_rounds = rounds;
+    opt.active_set.move_margin = move_margin;
     opt.solver_options.tol = 1e-8;
     opt.solver_options.max_iter = max_iter;
     const WetRun r = run_wet(net, m, Eigen::Matrix2d::Identity(), opt);

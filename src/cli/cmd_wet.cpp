@@ -157,6 +157,7 @@ void register_wet(CLI::App& app) {
         opt.solver = s.solver.name;
         opt.solver_options.tol = s.solver.tol, opt.solver_options.max_iter = s.solver.max_iter;
         opt.solver_options.verbose = w->verbose;
+        opt.active_set.verbose = w->verbose;
         opt.moduli = !w->no_moduli;
         make_solver(opt.solver, opt.solver_options);  // an unknown solver is an InputError before any work
         if (!s.wet.free_box && (o_fbs->count() || o_fbt->count()))

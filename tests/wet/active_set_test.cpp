@@ -80,6 +80,41 @@ TEST_CASE("active set: a bridge dragged across a kinked node moves without an en
     CHECK(d.max_step < 0.04 * 0.25);  // the 0.25 change is spread over the blend zone (2 delta = 0.5, 100 steps)
 }
 
+TEST_CASE("active set: a bridge moves only a margin past a node (hysteresis against ping-pong)", "[wet][events]") {
+    // As above: fiber 1 kinked at x = 13 (segments of 1: blend half-width delta = 0.25), fiber 2 at 60 deg crossing at
+    // 12.5 and dragged along x, so the crossing moves with it. move_margin = 0.1: a move needs 0.025 past the node.
+    const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.25, 1.5, 60, 1, 0.45}}, 3);
+    const Model m = model_of(net);
+    NetworkEnergy e(m);
+    Eigen::VectorXd pos = m.x;
+    const double kink = 15 * M_PI / 180;
+    for (int n : m.chains[0].nodes) {
+        const double x = pos[2 * n] - 13, y = pos[2 * n + 1] - 15;
+        if (x > 1e-9) pos[2 * n] = 13 + std::cos(kink) * x - std::sin(kink) * y, pos[2 * n + 1] = 15 + std::sin(kink) * x + std::cos(kink) * y;
+    }
+    const Eigen::VectorXd q = e.dofs(pos);
+    std::vector<Bridge> bridges = wet_crossings(net, m, e.positions(q, I2), m.box.B0(), {});
+    REQUIRE(bridges.size() == 1);
+    REQUIRE(bridges[0].k1 == 2);
+    ActiveSetOptions opt;
+    opt.form_new = false;
+    REQUIRE(opt.move_margin == 0.1);
+    auto home_after = [&](double dx) {
+        update_bridges(e, moved(e, q, 1, dx, 0), I2, bridges, opt);
+        REQUIRE(bridges.size() == 1);
+        return bridges[0].k1;
+    };
+    CHECK(home_after(0.5 + 0.01) == 2);  // past the node by less than the margin: stays
+    CHECK(home_after(0.5 + 0.04) == 3);  // beyond it: moves
+    CHECK(home_after(0.5 + 0.01) == 3);  // back within the margin: stays on the new home
+    CHECK(home_after(0.5 - 0.01) == 3);
+    CHECK(home_after(0.5 - 0.04) == 2);  // back beyond the margin: moves back
+    // With no margin the same states move the bridge each time the node is crossed.
+    opt.move_margin = 0;
+    CHECK(home_after(0.5 + 0.01) == 3);
+    CHECK(home_after(0.5 - 0.01) == 2);
+}
+
 TEST_CASE("active set: sliding along a straight fiber keeps the capillary energy", "[wet][events]") {
     // Fiber 2 translated along its own axis: its crossing slides along fiber 2 across nodes (equal segments).
     const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.55, 1.5, 70, 1, 0.45}}, 3);

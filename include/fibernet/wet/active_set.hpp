@@ -2,8 +2,9 @@
 // Relaxation under capillary load with mobile bridges (issue 6, part 2): an outer active-set loop around a
 // minimizer. The energy is smooth while the set of bridged segment pairs is fixed (WetEnergy); between solves the
 // set is updated from the relaxed geometry:
-//   move     a crossing left its home segment: the bridge moves to the neighbouring segment (no energy change, see
-//            bridge.hpp), repeatedly, until its crossing is inside its home pair;
+//   move     a crossing left its home segment by more than move_margin x the blend half-width: the bridge moves to
+//            the neighbouring segment (no energy change, see bridge.hpp), repeatedly; the margin is a hysteresis that
+//            keeps a bridge whose crossing sits at a node from sliding back and forth every round (cycling);
 //   rupture  a crossing slid past a fiber end far enough that the bridge's weight is zero (no energy change);
 //   form     two segments of different fibers intersect with no bridge on or next to that pair (fibers zipping):
 //            a new bridge (new crossings are always wet);
@@ -37,6 +38,8 @@ struct ActiveSetOptions {
     bool form_new = true;        // give new crossings and new contacts bridges
     double contact_distance = 0;  // seed units; 0: the fiber diameter 2 r = 2 ls / a
     double contact_angle_deg = 10;
+    bool verbose = false;         // one progress line per round on stderr
+    double move_margin = 0.1;     // a bridge moves once its crossing is this fraction of the blend half-width past a node
 };
 
 struct ActiveSetResult {

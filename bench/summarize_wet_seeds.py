@@ -1,0 +1,15 @@
+"""Summarizes bench_wet JSON lines (stdin): one row per run and the totals (bench/run_wet_seeds.sh)."""
+import json
+import sys
+
+rows = [json.loads(line) for line in sys.stdin if line.startswith("{")]
+print("run  fibers  rounds  stable  cycling  newton_its  events  wet_newton_s  events_s  total_s")
+for i, d in enumerate(rows, 1):
+    s = d["seconds"]
+    print(f"{i:3d}  {d['fibers']:6d}  {d['rounds']:6d}  {str(d['stable']):6s}  {str(d['cycling']):7s}  "
+          f"{d['newton_iterations']:10d}  {d['events']:6d}  {s['wet_newton']:12.2f}  {s['events']:8.3f}  {s['total']:7.2f}")
+its = sum(d["newton_iterations"] for d in rows)
+t = sum(d["seconds"]["wet_newton"] for d in rows)
+n = max(len(rows), 1)
+print(f"total: {len(rows)} runs, {sum(d['stable'] for d in rows)} stable, {sum(d['cycling'] for d in rows)} cycling, "
+      f"{its} Newton iterations ({its / n:.0f} per run), {t:.1f} s wet Newton ({t / n:.1f} s per run)")
