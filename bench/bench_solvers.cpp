@@ -15,11 +15,22 @@
 // floor) with budget --ref-budget, then every other solver runs from the same start with budget --budget; from each
 // recorded trace, the time at which max|g| first fell to --ratio-tol. Writes <out>/ratio.csv (one row per solver,
 // with t_other / t_ref, a lower bound where the other solver never got there) and <out>/ratio_trace.csv.
+// Mode "stability-wet" (issue 6): the stability map on wet scenes. Per (L, q, a, gamma, scheme): a Mikado network
+// with crosslink probability --pl (0.5), relaxed dry with Newton, wetted at all crossings exactly as run_wet does
+// (wet_crossings at the dry equilibrium, then update_bridges without new bridges); per beta in --betas, every solver
+// minimizes the WetEnergy of that fixed bridge set from the dry equilibrium with budget --budget (one value) and
+// tol = --rel-tol x max|g| at the start. Writes <out>/stability_wet.csv (one row per scene and solver: status, time,
+// max|g| relative to the start, energy, and whether it is within --best-tol of the lowest energy any solver returned,
+// measured as a fraction of the energy drop E_start - E_best) and <out>/stability_wet_relax.csv (per scene, the full
+// active-set relaxation, relax_wet with Newton as in `fibernet wet`, under one wall budget --relax-budget; 0 skips it).
+// Its own defaults: --L 3 --q 6,10 --gamma 0 --budget 1 --rel-tol 1e-8; --prune is refused (bridges sit on the arms).
+// --tol is the dry Newton relaxation's (500 iterations at most, as `fibernet wet`), and the wet one's if --rel-tol 0.
 //
-//   bench_solvers [--mode wp|stability|discretization|ratio] [--out DIR] [--L 4,8,12] [--q 8] [--a 10,100]
-//                 [--schemes seed,even] [--solvers newton,lbfgs,...] [--gamma 0.05] [--tol 1e-10]
+//   bench_solvers [--mode wp|stability|stability-wet|discretization|ratio] [--out DIR] [--L 4,8,12] [--q 8]
+//                 [--a 10,100] [--schemes seed,even] [--solvers newton,lbfgs,...] [--gamma 0.05] [--tol 1e-10]
 //                 [--budget 2,4,8] [--seed 1] [--max-iter N] [--rel-tol R] [--prune dangling,nonspanning,ends]
 //                 [--ref-budget 1800] [--ratio-tol 1e-6] [--verbose]
+//                 [--betas 0.01,0.1,1] [--pl 0.5] [--relax-budget 8] [--best-tol 1e-6]   (stability-wet only)
 // --rel-tol R > 0 sets each network's tolerance to R * max|g| at its start (the force scale grows like a^2 and
 // gamma, so one absolute tol means different things across the stability grid); otherwise --tol applies.
 // --prune: dangling/nonspanning prune the network (model/prune.hpp), ends trims the load-free end arms
@@ -34,6 +45,7 @@
 #include <iostream>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -47,6 +59,9 @@
 #include "fibernet/network/mikado.hpp"
 #include "fibernet/solve/solver.hpp"
 #include "fibernet/solve/solver_suite.hpp"
+#include "fibernet/wet/active_set.hpp"
+#include "fibernet/wet/wet_energy.hpp"
+#include "fibernet/wet/wetting.hpp"
 
 using namespace fibernet;
 
@@ -156,6 +171,208 @@ double time_to(const std::vector<Sample>& s, double thr) {
     return -1;
 }
 
+// ---- Mode "stability-wet" (issue 6: wet scenes in the stability map) ----
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// A solver that holds one wall-time budget across all its minimize() calls: each call gets what is left (the
+// active-set loop calls it once per round); once it is spent, minimize() returns Failed at once, which ends relax_wet.
+class DeadlineSolver : public Solver {
+public:
+    DeadlineSolver(std::string name, SolverOptions opt, double seconds)
+        : name_(std::move(name)), opt_(opt), seconds_(seconds), t0_(std::chrono::steady_clock::now()) {}
+    std::string name() const override { return name_; }
+    SolveResult minimize(Objective& f, Eigen::VectorXd& q) override {
+        const double left = seconds_ - seconds_since(t0_);
+        if (left <= 0) {
+            spent = true;
+            SolveResult r;
+            r.status = SolveStatus::Failed, r.solver = name_;
+            r.message = "the bench's wall budget for the whole relaxation is spent";
+            Eigen::VectorXd g;
+            r.energy = f.gradient(q, g);
+            r.grad_max = g.size() ? g.lpNorm<Eigen::Infinity>() : 0.0;
+            return r;
+        }
+        SolverOptions o = opt_;
+        o.max_seconds = o.max_seconds > 0 ? std::min(o.max_seconds, left) : left;
+        return make_solver(name_, o)->minimize(f, q);
+    }
+    bool spent = false;
+
+private:
+    std::string name_;
+    SolverOptions opt_;
+    double seconds_;
+    std::chrono::steady_clock::time_point t0_;
+};
+
+std::string csv_text(std::string s) {
+    std::replace(s.begin(), s.end(), ',', ';');
+    std::replace(s.begin(), s.end(), '"', '\'');
+    return "\"" + s + "\"";
+}
+
+struct WetGrid {
+    std::vector<double> Ls, qs, as, gammas, betas;
+    std::vector<std::string> schemes, solvers;
+    double pl = 0.5, budget = 1, relax_budget = 8, rel_tol = 1e-8, tol_abs = 1e-10, best_tol = 1e-6;
+    int max_iter = 100000000;
+    std::uint64_t seed = 1;
+    bool verbose = false;
+    std::string out;
+};
+
+// Every solver on the same wet problem: the WetEnergy of a fixed bridge set (the wet crossings of the dry
+// equilibrium, made consistent with the geometry exactly as run_wet does before its first solve), from the dry
+// equilibrium, with the same wall budget and tolerance. Then, per scene, the full active-set relaxation (relax_wet
+// with Newton, as `fibernet wet` does) under one overall wall budget. Writes <out>/stability_wet.csv (one row per
+// scene and solver) and <out>/stability_wet_relax.csv (one row per scene; not with relax_budget = 0).
+int stability_wet(const WetGrid& G) {
+    std::ofstream runs(G.out + "/stability_wet.csv"), relax;
+    if (G.relax_budget > 0) relax.open(G.out + "/stability_wet_relax.csv");
+    if (!runs || (G.relax_budget > 0 && !relax)) {
+        std::cerr << "cannot write to " << G.out << "\n";
+        return 1;
+    }
+    runs << "case,scheme,L,q,pl,a,gamma,beta,seed,fibers,crossings,dof,bridges,solver,status,iterations,evaluations,"
+            "factorizations,seconds,budget_s,tol,grad_start,grad_max,grad_rel,energy_start,energy,energy_best,"
+            "rel_energy_gap,at_best,message\n";
+    relax << "case,scheme,L,q,pl,a,gamma,beta,seed,fibers,crossings,dof,dry_status,dry_iterations,dry_seconds,"
+             "bridges_initial,bridges_final,outcome,rounds,stable,cycling,iterations,seconds,seconds_solve,"
+             "seconds_events,budget_s,tol,last_status,grad_max,energy,moves,ruptures,formed,merged,locked,message\n";
+    for (double L : G.Ls)
+        for (double qd : G.qs)
+            for (double a : G.as)
+                for (double gamma : G.gammas)
+                    for (const auto& sc : G.schemes) {
+                        MikadoParams mp;
+                        mp.L = L, mp.q = qd, mp.pl = G.pl, mp.seed = G.seed, mp.periodic = true;
+                        const Network net = generate_mikado(mp);
+                        DiscretizationParams dp;
+                        dp.scheme = parse_scheme(sc), dp.aspect_ratio = a;  // no trimmed ends: bridges sit on the arms
+                        const Model model = discretize(net, dp);
+                        const NetworkEnergy dry(model);
+                        const Eigen::Matrix2d F = deformation(StrainKind::Shear, gamma);
+                        const Eigen::Matrix2d B = F * model.box.B0();
+                        // Dry equilibrium with Newton, as run_wet does (at gamma = 0 the rest state already is one).
+                        Eigen::VectorXd q_dry = dry.affine_map(dry.dofs(model.x), Eigen::Matrix2d::Identity(), F);
+                        SolverOptions dopt;
+                        dopt.tol = G.tol_abs, dopt.max_iter = 500, dopt.verbose = G.verbose;
+                        auto t0 = std::chrono::steady_clock::now();
+                        WetEnergy D(dry, F, {}, WetParams{});
+                        const SolveResult dres = make_solver("newton", dopt)->minimize(D, q_dry);
+                        const double t_dry = seconds_since(t0);
+                        // Bridges at the dry equilibrium's crossings, consistent with the geometry (run_wet).
+                        std::vector<Bridge> bridges =
+                            wet_crossings(net, model, dry.positions(q_dry, F), B, WettingRule{});
+                        const size_t n_wet = bridges.size();
+                        ActiveSetOptions first;
+                        first.form_new = false;
+                        update_bridges(dry, q_dry, F, bridges, first);
+                        std::ostringstream sid;
+                        sid << sc << "_L" << L << "_q" << qd << "_a" << a << "_g" << gamma;
+                        std::fprintf(stderr, "wet %s: %zu fibers, %zu crossings, %d DOF, %zu bridges (%zu wet crossings); "
+                                     "dry newton %s, %d it, %.3fs\n", sid.str().c_str(), net.fibers.size(),
+                                     net.crossings.size(), dry.num_dofs(), bridges.size(), n_wet,
+                                     to_string(dres.status).c_str(), dres.iterations, t_dry);
+                        std::ostringstream scene;
+                        scene << sc << "," << L << "," << qd << "," << G.pl << "," << a << "," << gamma;
+                        for (double beta : G.betas) {
+                            std::ostringstream cid;
+                            cid << "wet_" << sid.str() << "_b" << beta;
+                            WetParams wp;
+                            wp.beta = beta;
+                            WetEnergy W0(dry, F, bridges, wp);
+                            Eigen::VectorXd g0;
+                            const double E0 = W0.gradient(q_dry, g0);
+                            const double g0max = g0.size() ? g0.lpNorm<Eigen::Infinity>() : 0.0;
+                            const double tol = G.rel_tol > 0 ? G.rel_tol * g0max : G.tol_abs;
+                            std::ostringstream head;
+                            head << cid.str() << "," << scene.str() << "," << beta << "," << G.seed << ","
+                                 << net.fibers.size() << "," << net.crossings.size() << "," << dry.num_dofs();
+                            std::vector<SolveResult> rs;
+                            for (const auto& name : G.solvers) {
+                                SolverOptions opt;
+                                opt.tol = tol, opt.max_iter = G.max_iter, opt.max_seconds = G.budget;
+                                opt.verbose = G.verbose;
+                                WetEnergy W(dry, F, bridges, wp);
+                                Eigen::VectorXd q = q_dry;
+                                SolveResult r;
+                                try {
+                                    r = make_solver(name, opt)->minimize(W, q);
+                                } catch (const std::exception& e) {
+                                    r.status = SolveStatus::Failed, r.solver = name;
+                                    r.message = std::string("exception: ") + e.what();
+                                    r.energy = std::numeric_limits<double>::quiet_NaN();
+                                }
+                                std::fprintf(stderr, "  %-32s %-14s %-18s it %7d  t %6.3fs  E %.12g  max|g|/g0 %.1e  %s\n",
+                                             cid.str().c_str(), name.c_str(), to_string(r.status).c_str(), r.iterations,
+                                             r.timings.total, r.energy, r.grad_max / g0max, r.message.c_str());
+                                rs.push_back(r);
+                            }
+                            // The best energy any solver returned; gaps relative to the energy drop E0 - E_best.
+                            double best = std::numeric_limits<double>::infinity();
+                            for (const auto& r : rs)
+                                if (std::isfinite(r.energy)) best = std::min(best, r.energy);
+                            const double drop = std::max(E0 - best, 1e-300);
+                            for (size_t k = 0; k < rs.size(); ++k) {
+                                const SolveResult& r = rs[k];
+                                const double gap = (r.energy - best) / drop;
+                                runs << head.str() << "," << bridges.size() << "," << G.solvers[k] << ","
+                                     << to_string(r.status) << "," << r.iterations << "," << r.evaluations << ","
+                                     << r.factorizations << "," << r.timings.total << "," << G.budget << "," << tol
+                                     << "," << g0max << "," << r.grad_max << "," << r.grad_max / g0max << ","
+                                     << std::setprecision(17) << E0 << "," << r.energy << "," << best << ","
+                                     << std::setprecision(6) << gap << "," << (std::isfinite(gap) && gap <= G.best_tol)
+                                     << "," << csv_text(r.message) << "\n";
+                            }
+                            runs.flush();
+                            if (G.relax_budget <= 0) continue;
+                            // The full active-set relaxation with Newton (moves, ruptures, new bridges), one budget.
+                            SolverOptions nopt;
+                            nopt.tol = tol, nopt.max_iter = 500, nopt.verbose = G.verbose;
+                            DeadlineSolver newton("newton", nopt, G.relax_budget);
+                            Eigen::VectorXd q = q_dry;
+                            t0 = std::chrono::steady_clock::now();
+                            ActiveSetResult ar;
+                            std::string outcome;
+                            try {
+                                ar = relax_wet(dry, F, wp, bridges, newton, q, ActiveSetOptions{});
+                                outcome = ar.stable    ? "stable"
+                                          : ar.cycling ? "cycling"
+                                          : newton.spent ? "budget"
+                                          : ar.last.converged() || ar.last.status == SolveStatus::IterationLimit
+                                              ? "max_rounds"
+                                              : "failed";
+                            } catch (const std::exception& e) {
+                                outcome = "failed", ar.message = std::string("exception: ") + e.what();
+                            }
+                            const double t_relax = seconds_since(t0);
+                            const double E = WetEnergy(dry, F, ar.bridges, wp).value(q);
+                            std::fprintf(stderr, "  %-32s %-14s %-18s it %7d  t %6.3fs  E %.12g  %d rounds  %zu -> %zu "
+                                         "bridges  %s\n", cid.str().c_str(), "active-set", outcome.c_str(),
+                                         ar.solver_iterations, t_relax, E, ar.rounds, bridges.size(),
+                                         ar.bridges.size(), ar.message.c_str());
+                            const WetEvents& ev = ar.events;
+                            relax << cid.str() << "," << scene.str() << "," << beta << "," << G.seed << ","
+                                  << net.fibers.size() << "," << net.crossings.size() << "," << dry.num_dofs() << ","
+                                  << to_string(dres.status) << "," << dres.iterations << "," << t_dry << ","
+                                  << bridges.size() << "," << ar.bridges.size() << "," << outcome << "," << ar.rounds
+                                  << "," << ar.stable << "," << ar.cycling << "," << ar.solver_iterations << ","
+                                  << t_relax << "," << ar.seconds_solve << "," << ar.seconds_events << ","
+                                  << G.relax_budget << "," << tol << "," << to_string(ar.last.status) << ","
+                                  << ar.last.grad_max << "," << std::setprecision(17) << E << std::setprecision(6)
+                                  << "," << ev.moves << "," << ev.ruptures << "," << ev.formed << "," << ev.merged
+                                  << "," << ev.locked << "," << csv_text(ar.message) << "\n";
+                            relax.flush();
+                        }
+                    }
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -165,7 +382,9 @@ int main(int argc, char** argv) {
         {"budget", "2,4,8"},  {"seed", "1"},           {"max-iter", "100000000"}, {"verbose", "0"},
         {"solvers", ""},      {"rel-tol", "0"},      {"nseg", "2,3,5,10,20,40"}, {"h", "4,2,1,0.5,0.25,0.125,0.0625"},
         {"prune", ""},        {"ref-budget", "1800"}, {"ratio-tol", "1e-6"},
+        {"betas", "0.01,0.1,1"}, {"pl", "0.5"},     {"relax-budget", "8"}, {"best-tol", "1e-6"},
     };
+    std::set<std::string> given;
     for (int i = 1; i < argc; ++i) {
         std::string k = argv[i];
         if (k.rfind("--", 0) != 0) {
@@ -177,6 +396,7 @@ int main(int argc, char** argv) {
             std::cerr << "unknown option --" << k << "\n";
             return 2;
         }
+        given.insert(k);
         if (k == "verbose") {
             arg[k] = "1";
             continue;
@@ -186,6 +406,84 @@ int main(int argc, char** argv) {
             return 2;
         }
         arg[k] = argv[++i];
+    }
+    const std::set<std::string> modes = {"wp", "stability", "stability-wet", "discretization", "ratio"};
+    if (!modes.count(arg["mode"])) {
+        std::cerr << "unknown mode " << arg["mode"] << " (expected wp, stability, stability-wet, discretization or ratio)\n";
+        return 2;
+    }
+    const bool wet = arg["mode"] == "stability-wet";
+    for (const char* k : {"betas", "pl", "relax-budget", "best-tol"})
+        if (!wet && given.count(k)) {
+            std::cerr << "--" << k << " applies to --mode stability-wet only\n";
+            return 2;
+        }
+    if (wet) {
+        if (given.count("prune")) {
+            std::cerr << "--prune does not apply to --mode stability-wet (bridges sit on the end arms)\n";
+            return 2;
+        }
+        // The wet grid's own defaults: the small pl = 0.5 networks of docs/wet.md, unstrained as `fibernet wet`.
+        const std::map<std::string, std::string> wet_defaults = {
+            {"L", "3"}, {"q", "6,10"}, {"gamma", "0"}, {"budget", "1"}, {"rel-tol", "1e-8"}};
+        for (const auto& [k, v] : wet_defaults)
+            if (!given.count(k)) arg[k] = v;
+        WetGrid G;
+        // Numbers of option k, or an error naming it.
+        auto nums = [&](const std::string& k) {
+            try {
+                return split_d(arg[k]);
+            } catch (const std::exception&) {
+                throw std::runtime_error("--" + k + " " + arg[k] + " is not a list of numbers");
+            }
+        };
+        auto num = [&](const std::string& k) {
+            const auto v = nums(k);
+            if (v.size() != 1) throw std::runtime_error("--" + k + " takes one number in --mode stability-wet");
+            return v[0];
+        };
+        try {
+            G.Ls = nums("L"), G.qs = nums("q"), G.as = nums("a"), G.gammas = nums("gamma"), G.betas = nums("betas");
+            G.schemes = split(arg["schemes"]);
+            G.budget = num("budget"), G.pl = num("pl"), G.relax_budget = num("relax-budget");
+            G.rel_tol = num("rel-tol"), G.tol_abs = num("tol"), G.best_tol = num("best-tol");
+            const double mi = num("max-iter"), sd = num("seed");
+            if (!(mi >= 1 && mi <= 2e9 && mi == std::floor(mi))) throw std::runtime_error("--max-iter must be a positive integer");
+            if (!(sd >= 0 && sd == std::floor(sd))) throw std::runtime_error("--seed must be an integer >= 0");
+            G.max_iter = static_cast<int>(mi), G.seed = std::stoull(arg["seed"]);
+            G.verbose = arg["verbose"] == "1", G.out = arg["out"];
+            G.solvers = split(arg["solvers"]);
+            if (G.solvers.empty()) {
+                G.solvers.push_back("newton");
+                for (const auto& n : suite_solver_names()) G.solvers.push_back(n);
+            }
+            for (const auto& n : G.solvers) make_solver(n, SolverOptions{});  // an unknown name fails here
+            for (const auto& sc : G.schemes) parse_scheme(sc);
+            if (G.Ls.empty() || G.qs.empty() || G.as.empty() || G.gammas.empty() || G.betas.empty() ||
+                G.schemes.empty())
+                throw std::runtime_error("--L, --q, --a, --gamma, --betas and --schemes need at least one value");
+            for (double b : G.betas)
+                if (!(b > 0)) throw std::runtime_error("--betas must be > 0 (beta = 0 is the dry map)");
+            if (!(G.pl >= 0 && G.pl <= 1)) throw std::runtime_error("--pl must lie in [0, 1]");
+            if (!(G.budget > 0)) throw std::runtime_error("--budget must be > 0 seconds");
+            if (!(G.relax_budget >= 0)) throw std::runtime_error("--relax-budget must be >= 0 seconds (0: skip)");
+            if (!(G.best_tol >= 0)) throw std::runtime_error("--best-tol must be >= 0");
+            for (double L : G.Ls)
+                for (double q : G.qs) {
+                    MikadoParams mp;
+                    mp.L = L, mp.q = q, mp.pl = G.pl, mp.seed = G.seed;
+                    mp.check("bench_solvers");
+                }
+            for (double a : G.as) {
+                DiscretizationParams dp;
+                dp.aspect_ratio = a;
+                dp.check("bench_solvers");
+            }
+        } catch (const std::exception& e) {
+            std::cerr << "bad option: " << e.what() << "\n";
+            return 2;
+        }
+        return stability_wet(G);
     }
     std::vector<std::string> solvers = split(arg["solvers"]);
     if (solvers.empty()) {
