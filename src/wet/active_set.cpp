@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <cstdio>
+#include <iterator>
 #include <set>
 
 #include "fibernet/wet/wetting.hpp"
@@ -172,7 +173,8 @@ std::vector<Bridge> segment_contacts(const Model& m, const Eigen::VectorXd& x, c
 }
 
 WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
-                         std::vector<Bridge>& bridges, const ActiveSetOptions& opt) {
+                         std::vector<Bridge>& bridges, const ActiveSetOptions& opt, const FiberPairs* frozen) {
+    auto is_frozen = [&](int f1, int f2) { return frozen && frozen->count({std::min(f1, f2), std::max(f1, f2)}); };
     const Model& m = dry.model();
     const Eigen::VectorXd x = dry.positions(q, F);
     const Eigen::Matrix2d B = F * m.box.B0();
@@ -188,6 +190,10 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
     std::vector<Bridge> kept;
     kept.reserve(bridges.size());
     for (Bridge b : bridges) {
+        if (is_frozen(b.f1, b.f2)) {  // kept as it is (relax_wet, after cycling)
+            kept.push_back(b);
+            continue;
+        }
         bool alive = true;
         if (b.locked) {
             const Contact c = pair_contact(b);
@@ -263,13 +269,28 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
         const bool known = std::any_of(v.begin(), v.end(), [&](const std::pair<int, int>& h) {
             return std::abs(h.first - c.k1) <= 1 && std::abs(h.second - c.k2) <= 1;
         });
-        if (known) continue;
+        if (known || is_frozen(c.f1, c.f2)) continue;
+        // The move margin at fiber ends too: a crossing within it of an end forms no bridge. Such a bridge has under
+        // half its weight, its crossing can slide off the end (rupture) and back in (form) on alternate rounds
+        // (cycling; seen on a 100-fiber benchmark network).
+        {
+            const BridgeElement el = resolve(m, c);
+            const CrossingPosition cp = crossing_position(el, element_coordinates(el, x, B));
+            bool near_end = false;
+            for (int s = 0; s < 2 && cp.defined; ++s) {
+                const int k = s == 0 ? c.k1 : c.k2;
+                const int nseg = static_cast<int>(m.chains[s == 0 ? c.f1 : c.f2].segments.size());
+                near_end = near_end || (k == 0 && cp.z[s][0] < opt.move_margin * cp.delta[s][0]) ||
+                           (k + 1 == nseg && cp.z[s][1] > -opt.move_margin * cp.delta[s][1]);
+            }
+            if (near_end) continue;
+        }
         note(c);
         bridges.push_back(c);
         ++ev.formed;
     }
     for (const Bridge& c : segment_contacts(m, x, B, rc, opt.contact_angle_deg)) {
-        if (partnered.count({c.f1, c.k1, c.f2}) || partnered.count({c.f2, c.k2, c.f1})) continue;
+        if (partnered.count({c.f1, c.k1, c.f2}) || partnered.count({c.f2, c.k2, c.f1}) || is_frozen(c.f1, c.f2)) continue;
         note(c);
         bridges.push_back(c);
         ++ev.formed;
@@ -286,7 +307,9 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         std::sort(v.begin(), v.end());
         return v;
     };
-    std::set<std::vector<std::array<int, 7>>> seen{signature(bridges)};
+    std::vector<std::vector<std::array<int, 7>>> history{signature(bridges)};  // the set after each round (0: start)
+    FiberPairs frozen;
+    int freezes = 0;
     for (int round = 1; round <= opt.max_rounds; ++round) {
         r.rounds = round;
         WetEnergy W(dry, F, bridges, params);
@@ -302,7 +325,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             break;
         }
         t0 = now();
-        const WetEvents ev = update_bridges(dry, q, F, bridges, opt);
+        const WetEvents ev = update_bridges(dry, q, F, bridges, opt, &frozen);
         r.per_round.push_back(ev);
         r.events.moves += ev.moves, r.events.ruptures += ev.ruptures;
         r.events.formed += ev.formed, r.events.merged += ev.merged, r.events.locked += ev.locked;
@@ -316,22 +339,55 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             equilibrium = g.size() == 0 || g.cwiseAbs().maxCoeff() <= r.last.grad_max * (1 + 1e-9);
         }
         r.seconds_events += now() - t0;
-        if (equilibrium) {
-            r.stable = true;
-            r.message = "stable after " + std::to_string(round) + " round(s)";
-            break;
-        }
         if (opt.verbose)
             std::fprintf(stderr,
                          "wet round %2d: %s in %d iterations (max|g| %.2e), %zu bridges after moves %d, ruptures %d, "
                          "formed %d, merged %d, locked %d\n",
                          round, to_string(r.last.status).c_str(), r.last.iterations, r.last.grad_max, bridges.size(),
                          ev.moves, ev.ruptures, ev.formed, ev.merged, ev.locked);
-        if (!limit && !seen.insert(signature(bridges)).second) {
-            r.cycling = true;
-            r.message = "cycling: the bridge set after round " + std::to_string(round) + " repeats an earlier one";
+        if (equilibrium) {
+            r.stable = true;
+            r.message = "stable after " + std::to_string(round) + " round(s)" +
+                        (r.frozen_pairs ? " (" + std::to_string(r.frozen_pairs) + " fiber pair(s) frozen after " +
+                                              std::to_string(r.cycles_broken) + " cycle(s))"
+                                        : std::string());
             break;
         }
+        const auto sig = signature(bridges);
+        const auto again = std::find(history.begin(), history.end(), sig);
+        if (!limit && again != history.end()) {
+            // Name what toggles: the bridges in which the sets after the repeated round and after the next differ.
+            const size_t j = static_cast<size_t>(again - history.begin());
+            std::vector<std::array<int, 7>> diff;  // empty if the set did not change at all (a solver that wanders)
+            if (j + 1 < history.size())
+                std::set_symmetric_difference(history[j].begin(), history[j].end(), history[j + 1].begin(),
+                                              history[j + 1].end(), std::back_inserter(diff));
+            std::string which;
+            for (size_t k = 0; k < diff.size() && k < 4; ++k)
+                which += (k ? ", " : "") + std::string("fibers ") + std::to_string(diff[k][0]) + "/" + std::to_string(diff[k][1]) +
+                         " segments " + std::to_string(diff[k][2]) + "/" + std::to_string(diff[k][3]);
+            const std::string what = "the bridge set after round " + std::to_string(round) + " repeats " +
+                                     (j == 0 ? std::string("the initial one") : "that after round " + std::to_string(j)) +
+                                     "; " + std::to_string(diff.size()) + " bridge entries toggle (" + which +
+                                     (diff.size() > 4 ? ", ..." : "") + ")";
+            // Break the cycle: the fiber pairs of the toggling bridges keep their current bridges from here on (no
+            // moves, ruptures or new bridges between them), and the rounds go on. What follows is an equilibrium of
+            // the energy with that set; the pairs are reported (frozen_pairs).
+            size_t before = frozen.size();
+            for (const auto& d : diff) frozen.insert({std::min(d[0], d[1]), std::max(d[0], d[1])});
+            if (freezes < opt.max_freezes && frozen.size() > before) {
+                ++freezes;
+                r.frozen_pairs = static_cast<int>(frozen.size());
+                r.cycles_broken = freezes;
+                if (opt.verbose) std::fprintf(stderr, "wet round %2d: cycling (%s): fiber pairs frozen\n", round, what.c_str());
+                history.assign(1, sig);
+                continue;
+            }
+            r.cycling = true;
+            r.message = "cycling: " + what;
+            break;
+        }
+        history.push_back(sig);
         if (round == opt.max_rounds)
             r.message = "no stable bridge set after " + std::to_string(round) + " rounds (last solve: " +
                         to_string(r.last.status) + ")";

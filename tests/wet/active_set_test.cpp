@@ -220,10 +220,46 @@ TEST_CASE("active set: a bridge set that repeats is reported as cycling", "[wet]
     Eigen::VectorXd q = q0;
     ActiveSetOptions opt;
     opt.form_new = false;
+    opt.max_freezes = 0;  // report the first repeat
     const ActiveSetResult r = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver, q, opt);
     CHECK(r.cycling);
     CHECK(!r.stable);
     CHECK(r.rounds == 3);
     CHECK(r.message.find("cycling") != std::string::npos);
+    CHECK(r.message.find("fibers 0/1") != std::string::npos);  // names the toggling bridge
     CHECK(r.events.moves >= 3);
+    CHECK(r.cycles_broken == 0);
+
+    // By default the repeat is broken by freezing the pair's bridge; this stand-in solver still never reaches an
+    // equilibrium (it alternates whatever the energy), so the loop ends cycling after the frozen round repeats.
+    Alternating solver2(moved(e, q0, 1, -2, 0), moved(e, q0, 1, -1, 0));
+    Eigen::VectorXd q2 = q0;
+    ActiveSetOptions opt2;
+    opt2.form_new = false;
+    const ActiveSetResult r2 = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver2, q2, opt2);
+    CHECK(r2.cycles_broken == 1);
+    CHECK(r2.frozen_pairs == 1);
+    CHECK(r2.cycling);
+    CHECK(!r2.stable);
+    CHECK(r2.rounds < opt2.max_rounds);
+}
+
+TEST_CASE("active set: bridges of a frozen fiber pair are kept as they are", "[wet][events]") {
+    // How relax_wet breaks a cycle (active_set.hpp). On the benchmark networks (bench/run_wet_seeds.sh) the frozen
+    // runs end stable; here: the update leaves a frozen pair's bridge where it is.
+    const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.45, 1.5, 60, 1, 0.45}}, 3);
+    const Model m = model_of(net);
+    NetworkEnergy e(m);
+    Eigen::VectorXd q = e.dofs(m.x);
+    std::vector<Bridge> bridges = wet_crossings(net, m, m.x, m.box.B0(), {});
+    REQUIRE(bridges.size() == 1);
+    const FiberPairs frozen{{0, 1}};
+    // Dragged far past the node, a frozen bridge stays where it is; an unfrozen one moves.
+    std::vector<Bridge> kept = bridges, free = bridges;
+    ActiveSetOptions opt;
+    opt.form_new = false;
+    const Eigen::VectorXd far = moved(e, q, 1, 0.6, 0);
+    CHECK(update_bridges(e, far, I2, kept, opt, &frozen).moves == 0);
+    CHECK(kept[0].k1 == bridges[0].k1);
+    CHECK(update_bridges(e, far, I2, free, opt).moves >= 1);
 }

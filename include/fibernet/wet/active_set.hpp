@@ -17,10 +17,15 @@
 //            twice the angle and the distance).
 // The loop stops when q is an equilibrium of the updated set (stable: its gradient is no larger than the one the solver
 // accepted, so moves and locks, which leave the energy unchanged, need no new solve), when a bridge set repeats an
-// earlier round's (cycling, reported, the last state kept), when the solver fails, or after max_rounds. A solve that
+// earlier round's more than max_freezes times (cycling, reported, the last state kept), when the solver fails, or after
+// max_rounds. A repeat is first broken: the fiber pairs whose bridges toggle are frozen (their bridges kept as they
+// are, no new ones) and the rounds go on, so the result is an equilibrium with a set that obeys the rules everywhere
+// but on those pairs (counted: cycles_broken, frozen_pairs). A solve that
 // hits its iteration limit is not a failure: the set is updated and the next round continues from there.
 #include <Eigen/Core>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fibernet/solve/solver.hpp"
@@ -39,6 +44,7 @@ struct ActiveSetOptions {
     double contact_distance = 0;  // seed units; 0: the fiber diameter 2 r = 2 ls / a
     double contact_angle_deg = 10;
     bool verbose = false;         // one progress line per round on stderr
+    int max_freezes = 5;          // cycles broken by freezing their fiber pairs before cycling is final
     double move_margin = 0.1;     // a bridge moves once its crossing is this fraction of the blend half-width past a node
 };
 
@@ -49,14 +55,21 @@ struct ActiveSetResult {
     std::vector<WetEvents> per_round;
     int rounds = 0, solver_iterations = 0;
     bool stable = false;           // the last round changed nothing: q is an equilibrium with a consistent set
-    bool cycling = false;          // a bridge set repeated
+    bool cycling = false;          // a bridge set repeated after max_freezes cycles were broken
+    int cycles_broken = 0;         // cycles broken by freezing the toggling fiber pairs
+    int frozen_pairs = 0;          // fiber pairs whose bridges were frozen
     std::string message;
     double seconds_solve = 0, seconds_events = 0;
 };
 
+// Fiber pairs (lower index first).
+using FiberPairs = std::set<std::pair<int, int>>;
+
 // Updates `bridges` (moves, ruptures, merges; new bridges if form_new) at state q of `dry` at F; returns the counts.
+// Bridges between `frozen` fiber pairs are kept unchanged and such pairs get no new bridges.
 WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
-                         std::vector<Bridge>& bridges, const ActiveSetOptions& opt = {});
+                         std::vector<Bridge>& bridges, const ActiveSetOptions& opt = {},
+                         const FiberPairs* frozen = nullptr);
 
 // All intersecting segment pairs of different fibers that share no node, as bridges (nearest periodic image).
 std::vector<Bridge> segment_crossings(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B);
