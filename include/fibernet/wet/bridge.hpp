@@ -65,6 +65,11 @@ Vector16d element_coordinates(const BridgeElement& e, const Eigen::VectorXd& x, 
 // is cheap; the whole 16 x 16 block inside a blend zone).
 double bridge_element_energy(const BridgeElement& e, const Vector16d& X, double beta, const CapillaryLaw& law,
                              Vector16d* grad, Matrix16d* hess, bool project_psd = false);
+// The same by the original evaluation (weights differentiated in Jet<16> through all 16 coordinates): several times
+// slower, kept to check bridge_element_energy against (tests/wet/bridge_fast_test.cpp, bench/bench_bridge_eval.cpp).
+double bridge_element_energy_reference(const BridgeElement& e, const Vector16d& X, double beta,
+                                       const CapillaryLaw& law, Vector16d* grad, Matrix16d* hess,
+                                       bool project_psd = false);
 
 // Where the crossing is relative to the home pair: side s, z[s][0] = arc distance from the home's start node to the
 // crossing (> 0: past the start), z[s][1] = from its end node (< 0: before the end), delta[s][.] the blend

@@ -1,8 +1,9 @@
 #pragma once
 // A second-order forward-mode number: value, gradient and Hessian with respect to N inputs, carried through
-// arithmetic. The blended bridge element (bridge.hpp) is a long composition (segment vectors, signed distances,
-// smoothstep weights, the capillary law); writing its 16 x 16 Hessian by hand would be error-prone, so the element
-// is written once as a template and evaluated in Jet<16> where exact derivatives are needed.
+// arithmetic. The blended bridge element's weights (bridge.hpp) are a long composition (signed distances, rates,
+// crossing positions, smoothstep weights, the fade); writing their Hessians by hand would be error-prone, so they are
+// written once as a template and evaluated in Jet<8> (in the 8 signed distances, bridge.cpp) where exact derivatives
+// are needed.
 #include <Eigen/Core>
 #include <cmath>
 
@@ -10,12 +11,15 @@ namespace fibernet {
 
 template <int N>
 struct Jet {
-    double v = 0;
-    Eigen::Matrix<double, N, 1> g = Eigen::Matrix<double, N, 1>::Zero();
-    Eigen::Matrix<double, N, N> h = Eigen::Matrix<double, N, N>::Zero();
+    // Like a double (and an Eigen matrix), a default-initialized jet is left unset: zeroing an N x N Hessian costs
+    // about as much as a cheap operation, and the operations below assign all of their result. Constants: Jet(x).
+    double v;
+    Eigen::Matrix<double, N, 1> g;
+    Eigen::Matrix<double, N, N> h;
 
     Jet() = default;
-    Jet(double x) : v(x) {}  // NOLINT: a constant
+    Jet(double x)  // NOLINT: a constant
+        : v(x), g(Eigen::Matrix<double, N, 1>::Zero()), h(Eigen::Matrix<double, N, N>::Zero()) {}
     static Jet variable(double x, int i) {
         Jet j(x);
         j.g[i] = 1;
@@ -76,7 +80,11 @@ Jet<N> operator+(const Jet<N>& a, double s) {
 template <int N>
 Jet<N> operator+(double s, const Jet<N>& a) { return a + s; }
 template <int N>
-Jet<N> operator-(double s, const Jet<N>& a) { return -a + s; }
+Jet<N> operator-(double s, const Jet<N>& a) {
+    Jet<N> r;
+    r.v = s - a.v, r.g = -a.g, r.h = -a.h;
+    return r;
+}
 template <int N>
 Jet<N> operator-(const Jet<N>& a, double s) { return a + (-s); }
 template <int N>
