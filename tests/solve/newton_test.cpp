@@ -229,3 +229,65 @@ TEST_CASE("newton: a collapsed start is reported as non-finite, not hidden", "[n
     CHECK(r.status == SolveStatus::NonFinite);
     CHECK_FALSE(r.converged());
 }
+
+namespace {
+// Uncoupled double wells with stiff partners, f = sum_i x_i^4 / 4 - x_i^2 / 2 + 50 y_i^2: near x = 0 the exact Hessian
+// is indefinite (f'' = 3 x^2 - 1 < 0) while its projection (x block clamped to 0) is singular. As in the networks,
+// the negative curvature is soft against the stiff terms (the escalation stops at 0.2 mean |diag H|).
+class DoubleWells : public fibernet::Objective {
+public:
+    explicit DoubleWells(int n) : n_(n), P_(2 * n, 2 * n) {
+        std::vector<Eigen::Triplet<double>> t;
+        for (int i = 0; i < 2 * n; ++i) t.emplace_back(i, i, 0.0);
+        P_.setFromTriplets(t.begin(), t.end());
+        P_.makeCompressed();
+    }
+    int size() const override { return 2 * n_; }
+    double value(const Eigen::VectorXd& q) override {
+        double f = 0;
+        for (int i = 0; i < n_; ++i) f += std::pow(q[2 * i], 4) / 4 - q[2 * i] * q[2 * i] / 2 + 50 * q[2 * i + 1] * q[2 * i + 1];
+        return f;
+    }
+    double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override {
+        g.resize(2 * n_);
+        for (int i = 0; i < n_; ++i) g[2 * i] = std::pow(q[2 * i], 3) - q[2 * i], g[2 * i + 1] = 100 * q[2 * i + 1];
+        return value(q);
+    }
+    double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool project) override {
+        H = P_;
+        for (int i = 0; i < n_; ++i) {
+            const double hxx = 3 * q[2 * i] * q[2 * i] - 1;
+            H.coeffRef(2 * i, 2 * i) = project ? std::max(hxx, 0.0) : hxx;
+            H.coeffRef(2 * i + 1, 2 * i + 1) = 100;
+        }
+        return gradient(q, g);
+    }
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return P_; }
+
+private:
+    int n_;
+    Eigen::SparseMatrix<double> P_;
+};
+}  // namespace
+
+TEST_CASE("newton: an indefinite Hessian gets an escalated shift on the exact Hessian before projection", "[newton]") {
+    // Rung 0 raises the shift on the exact H (x4) until it factors (docs/moduli.md, "Newton ladder"); the projected
+    // rung would drop the negative curvature that drives x away from the saddle at 0.
+    DoubleWells f(3);
+    Eigen::VectorXd q(6);
+    q << 0.1, 0.5, -0.2, -0.3, 0.05, 1.0;
+    fibernet::SolverOptions o;
+    o.tol = 1e-12;
+    fibernet::NewtonSolver newton(o);
+    const fibernet::SolveResult r = newton.minimize(f, q);
+    REQUIRE(r.converged());
+    for (int i = 0; i < 3; ++i) {
+        CHECK(std::abs(std::abs(q[2 * i]) - 1) < 1e-10);  // a minimum, not the saddle x = 0
+        CHECK(std::abs(q[2 * i + 1]) < 1e-10);
+    }
+    REQUIRE(!newton.rungs().empty());
+    CHECK(newton.rungs()[0] == 0);  // the first step, at an indefinite H, stayed on the exact Hessian
+    int projected = 0;
+    for (int rung : newton.rungs()) projected += rung >= 1;
+    CHECK(projected == 0);
+}
