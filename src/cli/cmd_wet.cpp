@@ -111,7 +111,7 @@ void register_wet(CLI::App& app) {
         std::vector<double> betas;
         std::string law, crossings, out;
         std::uint64_t seed = 0;
-        bool no_moduli = false, verbose = false, free_box = false;
+        bool no_moduli = false, verbose = false, quiet = false, free_box = false;
         std::string free_box_shape;
         double free_box_tol = 0;
     };
@@ -131,7 +131,8 @@ void register_wet(CLI::App& app) {
                                   "stretch, sigma_xx, sigma_yy, sigma_xy -> 0; less robust, docs/wet.md)");
     auto* o_fbt = cmd->add_option("--free-box-tol", w->free_box_tol,
                                   "free box converged at |sigma| <= tol * sigma_c (default 1e-3)");
-    cmd->add_flag("-v,--verbose", w->verbose, "solver progress on stderr");
+    cmd->add_flag("-v,--verbose", w->verbose, "solver progress on stderr (one line per Newton iteration)");
+    cmd->add_flag("-q,--quiet", w->quiet, "no progress lines on stderr (default: one per beta and per active-set round)");
     cmd->callback([=] {
         const auto t_all = std::chrono::steady_clock::now();
         Scene s = flags->resolve();
@@ -157,7 +158,8 @@ void register_wet(CLI::App& app) {
         opt.solver = s.solver.name;
         opt.solver_options.tol = s.solver.tol, opt.solver_options.max_iter = s.solver.max_iter;
         opt.solver_options.verbose = w->verbose;
-        opt.active_set.verbose = w->verbose;
+        opt.active_set.verbose = w->verbose || !w->quiet;
+        if (w->verbose && w->quiet) throw InputError("--verbose and --quiet contradict each other");
         opt.moduli = !w->no_moduli;
         make_solver(opt.solver, opt.solver_options);  // an unknown solver is an InputError before any work
         if (!s.wet.free_box && (o_fbs->count() || o_fbt->count()))
@@ -166,7 +168,7 @@ void register_wet(CLI::App& app) {
         opt.free_box.enabled = s.wet.free_box;
         opt.free_box.isotropic = s.wet.free_box_shape == "isotropic";
         opt.free_box.tol = s.wet.free_box_tol;
-        opt.free_box.progress = true;
+        opt.free_box.progress = !w->quiet;
 
         const Network net = scene_network(s);
         if (s.wet.free_box && !net.periodic)
@@ -190,8 +192,12 @@ void register_wet(CLI::App& app) {
         std::vector<std::vector<double>> hist_values;
         for (size_t k = 0; k < betas.size(); ++k) {
             opt.params.beta = betas[k];
-            if (opt.free_box.enabled) std::fprintf(stderr, "wet: beta = %g\n", betas[k]);  // heads the progress lines
+            if (!w->quiet) std::fprintf(stderr, "wet: beta = %g (%zu of %zu)\n", betas[k], k + 1, betas.size());
             const WetRun r = run_wet(net, m, F, opt, k == 0 ? nullptr : &dry_state);
+            if (!w->quiet)
+                std::fprintf(stderr, "wet: beta = %g: %s, %zu bridges, %d solver iterations, %.1f s\n", betas[k],
+                             r.active.message.c_str(), r.active.bridges.size(), r.active.solver_iterations,
+                             r.active.seconds_solve + r.active.seconds_events);
             if (k == 0) dry_state = r.dry;
             const bool wet_good = r.dry.converged && r.wet.converged && r.active.stable;
             const bool good = wet_good && (!opt.free_box.enabled || r.free_box.converged);

@@ -26,6 +26,13 @@ TEST_CASE("cli wet: a small run writes its documented outputs", "[wet][cli]") {
     CHECK(j.find("\"capillary\"") != std::string::npos);
     CHECK(j.find("\"stable\"") != std::string::npos);
     CHECK(slurp(out + "/sweep.csv").rfind("beta,status,bridges", 0) == 0);
+    // Progress on stderr by default: a line per beta and per active-set round; none with --quiet.
+    const std::string err = slurp(tmpdir() + "/stderr");
+    CHECK(err.find("wet: beta = 0 (1 of 1)") != std::string::npos);
+    CHECK(err.find("wet round  1:") != std::string::npos);
+    CHECK(err.find("wet: beta = 0: stable after 1 round(s)") != std::string::npos);
+    REQUIRE(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0 --no-moduli -q") == 0);
+    CHECK(slurp(tmpdir() + "/stderr").empty());
 }
 
 TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
@@ -47,7 +54,8 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
                           Case{"--free-box --free-box-tol 0", "free_box_tol = 0"},
                           Case{"--free-box --free-box-tol nan", "free_box_tol = nan"},
                           Case{"--free-box-tol 1e-3", "--free-box-tol given without --free-box"},
-                          Case{"--free-box-shape full", "--free-box-shape given without --free-box"}}) {
+                          Case{"--free-box-shape full", "--free-box-shape given without --free-box"},
+                          Case{"-q -v", "--verbose and --quiet"}}) {
         INFO(c.args);
         CHECK(run("--L 2.5 --q 5 " + c.args + " -o " + out) == 2);
         CHECK(slurp(tmpdir() + "/stderr").find(c.needle) != std::string::npos);
