@@ -190,6 +190,20 @@ void register_wet(CLI::App& app) {
         std::vector<SvgPanel> panels;
         std::vector<std::string> hist_names;
         std::vector<std::vector<double>> hist_values;
+        auto summary = [&](bool complete) {
+            return nlohmann::json{{"scene", s.source},
+                                {"network", to_json(statistics(net))},
+                                {"model", to_json(summarize(m))},
+                                {"wet",
+                                 {{"law", s.wet.law.empty() ? "cos2" : s.wet.law},
+                                  {"crossings", s.wet.crossings},
+                                  {"fraction", s.wet.fraction},
+                                  {"free_box", s.wet.free_box}}},
+                                {"gamma", s.gamma},
+                                {"runs", runs},
+                                {"complete", complete},
+                                {"seconds", seconds_since(t_all)}};
+        };
         for (size_t k = 0; k < betas.size(); ++k) {
             opt.params.beta = betas[k];
             if (!w->quiet) std::fprintf(stderr, "wet: beta = %g (%zu of %zu)\n", betas[k], k + 1, betas.size());
@@ -282,18 +296,16 @@ void register_wet(CLI::App& app) {
                  {"seconds",
                   {{"dry", r.seconds_dry}, {"wet_solve", r.seconds_wet_solve}, {"events", r.seconds_events},
                    {"pores", r.seconds_pores}, {"moduli", r.seconds_moduli}}}});
+            // Finished betas survive an interrupt: the tables and summary.json (complete: false) are rewritten
+            // (atomically) after each one; the pictures and stdout come at the end.
+            if (!w->out.empty() && k + 1 < betas.size()) {
+                const std::string d = w->out + "/";
+                write_file_atomic(d + "sweep.csv", sweep.str());
+                write_file_atomic(d + "pores.csv", pore_csv.str());
+                emit_json(summary(false), d + "summary.json");
+            }
         }
-        nlohmann::json j = {{"scene", s.source},
-                            {"network", to_json(statistics(net))},
-                            {"model", to_json(summarize(m))},
-                            {"wet",
-                             {{"law", s.wet.law.empty() ? "cos2" : s.wet.law},
-                              {"crossings", s.wet.crossings},
-                              {"fraction", s.wet.fraction},
-                              {"free_box", s.wet.free_box}}},
-                            {"gamma", s.gamma},
-                            {"runs", runs},
-                            {"seconds", seconds_since(t_all)}};
+        const nlohmann::json j = summary(true);
         if (!w->out.empty()) {
             const std::string d = w->out + "/";
             write_file_atomic(d + "sweep.csv", sweep.str());
