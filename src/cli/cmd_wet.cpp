@@ -106,6 +106,7 @@ void register_wet(CLI::App& app) {
     auto* cmd = app.add_subcommand("wet", "wet a network: capillary bridges, bundles, pores, moduli dry and wet");
     auto flags = std::make_shared<SceneFlags>();
     flags->add(cmd, true);
+    cmd->get_option("--pl")->description("crosslink probability in [0, 1] (default 0.5 here, as the thesis's wet networks)");
     struct WetFlags {
         double beta = 0, fraction = 0;
         std::vector<double> betas;
