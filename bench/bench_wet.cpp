@@ -45,10 +45,13 @@ int main(int argc, char** argv) {
         "{\"fibers\": %zu, \"q\": %g, \"beta\": %g, \"nodes\": %d, \"bridges_initial\": %zu, \"bridges_final\": %zu, "
         "\"rounds\": %d, \"stable\": %s, \"cycling\": %s, \"cycles_broken\": %d, \"newton_iterations\": %d, \"events\": %d, "
         "\"seconds\": {\"build\": %.3f, \"dry\": %.3f, \"wet_newton\": %.3f, \"events\": %.3f, \"pores\": %.3f, "
-        "\"total\": %.3f}, \"message\": \"%s\"}\n",
+        "\"total\": %.3f}, \"last_solve\": {\"iterations\": %d, \"factorizations\": %d, \"assembly\": %.3f, "
+        "\"factorization\": %.3f, \"solve\": %.3f, \"line_search\": %.3f, \"total\": %.3f}, \"message\": \"%s\"}\n",
         net.fibers.size(), q, beta, m.num_nodes(), r.initial_bridges.size(), r.active.bridges.size(), r.active.rounds,
         r.active.stable ? "true" : "false", r.active.cycling ? "true" : "false", r.active.cycles_broken, r.active.solver_iterations,
         r.active.events.total(), t_build, r.seconds_dry, r.seconds_wet_solve, r.seconds_events, r.seconds_pores, total,
-        r.active.message.c_str());
+        r.active.last.iterations, r.active.last.factorizations, r.active.last.timings.assembly,
+        r.active.last.timings.factorization, r.active.last.timings.solve, r.active.last.timings.line_search,
+        r.active.last.timings.total, r.active.message.c_str());
     return 0;
 }
