@@ -97,6 +97,28 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
     const double mean_scale = std::max(std::accumulate(diag.begin(), diag.end(), 0.0) / n, std::numeric_limits<double>::min());
     std::nth_element(diag.begin(), diag.begin() + n / 2, diag.end());
     const double median_scale = std::max(diag[n / 2], std::numeric_limits<double>::min());
+    // The right-hand sides in comoving coordinates, the same for both shift scales below.
+    t0 = Clock::now();
+    const auto Hs = H.selfadjointView<Eigen::Upper>();
+    const Eigen::Matrix2d Finv = F.inverse();
+    const Eigen::VectorXd x = e.positions(q, F);  // absolute positions: the affine velocity is dF F^-1 x
+    const int M = static_cast<int>(modes.size());
+    Eigen::MatrixXd B(n, M), V(n, M);
+    for (int m = 0; m < M; ++m) {
+        // Comoving (affine) coordinates: with v = dF F^{-1} x the affine velocity of the free nodes,
+        //   E_tt - b.H^+ b = (E_tt + 2 v.b + v.H v) - (b + H v).H^+ (b + H v)     (b in range(H)),
+        // whose two terms are the affine and non-affine parts: O(G A) instead of O(L^2 k) with absolute
+        // coordinates, where box-crossing segments make E_tt ~ 1e8 and the cancellation costs 6 digits.
+        const Eigen::Matrix2d Vm = modes[m].dF * Finv;
+        Eigen::VectorXd v(n);
+        for (int i = 0; i < e.model().num_nodes(); ++i)
+            if (e.dof(i, 0) >= 0) v.segment<2>(e.dof(i, 0)) = Vm * x.segment<2>(2 * i);
+        const Eigen::VectorXd Hv = Hs * v;
+        out[m].E_tt += 2 * v.dot(b[m]) + v.dot(Hv);
+        B.col(m) = b[m] + Hv;
+        V.col(m) = v;
+    }
+    const double seconds_setup = since(t0);
     const std::vector<Modulus> base = out;
     CholmodLLT own;
     CholmodLLT& llt = shared_llt ? *shared_llt : own;
@@ -123,25 +145,6 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
 
         // Iterative refinement towards H^+ b, all modes at once (one multi-column solve per step).
         t0 = Clock::now();
-        const auto Hs = H.selfadjointView<Eigen::Upper>();
-        const Eigen::Matrix2d Finv = F.inverse();
-        const Eigen::VectorXd x = e.positions(q, F);  // absolute positions: the affine velocity is dF F^-1 x
-        const int M = static_cast<int>(modes.size());
-        Eigen::MatrixXd B(n, M), V(n, M);
-        for (int m = 0; m < M; ++m) {
-            // Comoving (affine) coordinates: with v = dF F^{-1} x the affine velocity of the free nodes,
-            //   E_tt - b.H^+ b = (E_tt + 2 v.b + v.H v) - (b + H v).H^+ (b + H v)     (b in range(H)),
-            // whose two terms are the affine and non-affine parts: O(G A) instead of O(L^2 k) with absolute
-            // coordinates, where box-crossing segments make E_tt ~ 1e8 and the cancellation costs 6 digits.
-            const Eigen::Matrix2d Vm = modes[m].dF * Finv;
-            Eigen::VectorXd v(n);
-            for (int i = 0; i < e.model().num_nodes(); ++i)
-                if (e.dof(i, 0) >= 0) v.segment<2>(e.dof(i, 0)) = Vm * x.segment<2>(2 * i);
-            const Eigen::VectorXd Hv = Hs * v;
-            out[m].E_tt += 2 * v.dot(b[m]) + v.dot(Hv);
-            B.col(m) = b[m] + Hv;
-            V.col(m) = v;
-        }
         // Preconditioned conjugate gradients on H u = b with the preconditioner (H + delta I)^{-1}, one independent CG
         // per mode, all modes' preconditioner solves in one multi-column CHOLMOD call. The preconditioned spectrum is
         // lambda / (lambda + delta): 1 for every stiff mode, so CG only has to resolve the few modes with lambda ~ delta
@@ -233,6 +236,7 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
     // The retry also when round-off stopped a CG before convergence (accepted with a small tail above, but a CG
     // stalled in the null space of a floppy part can understate its error: measured a G 4.6e-5 off with a bound of
     // 4e-7, tests/mechanics/moduli_test.cpp "[prune]"): the larger shift leaves fewer modes for the CG.
+    inf.seconds_solve += seconds_setup;
     const bool first = attempt(median_scale);
     bool stalled = false;
     for (const auto& m : out) stalled = stalled || m.stalled;
@@ -243,8 +247,8 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
         if (!attempt(std::max(mean_scale, 100 * median_scale)) && first) {
             out = kept, inf.message = kept_message;
         } else if (first) {
-            // Both attempts stopped somewhere: their difference is a measured lower bound on the error (stalled CGs
-            // understated it up to 100x: L = 80, G 0.018937 +- 6.5e-8 vs 0.0189328 +- 2.1e-6 at the larger shift).
+            // Both attempts stopped somewhere: their difference is a measured lower bound on the error (a stalled
+            // CG's own bound can be 100x too small, docs/moduli.md "Why the median").
             for (size_t m = 0; m < out.size(); ++m) out[m].error = std::max(out[m].error, std::abs(out[m].value - kept[m].value));
         }
     }

@@ -174,7 +174,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
             ++r.evaluations;
             projected = true;
         };
-        if (start_rung <= 0) {
+        if (start_rung <= 0) {  // H holds the exact Hessian (assembled with projected = start_rung >= 1)
             if (try_factor(mu)) {
                 rung = 0, shift = mu;
             } else {
@@ -182,13 +182,6 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
                 // the exact Hessian: negative curvature (capillary torques, buckling) is kept in every direction but
                 // the few unstable ones, where projecting each element's block would overstate the stiffness of the
                 // whole assembly and turn Newton into a linearly converging method (docs/moduli.md, "Newton ladder").
-                if (projected) {
-                    auto ta = Clock::now();
-                    f.hessian(q, gt, H, false);
-                    r.timings.assembly += since(ta);
-                    ++r.evaluations;
-                    projected = false;
-                }
                 double lam = std::max(kExactGrow * mu, kLambda0 * dm);
                 for (; lam <= kExactCap * dm && rung < 0; lam *= kExactGrow)
                     if (try_factor(lam)) rung = 0, shift = lam;

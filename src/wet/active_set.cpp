@@ -5,10 +5,11 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <map>
 #include <cstdio>
 #include <iterator>
+#include <map>
 #include <set>
+#include <utility>
 
 #include "fibernet/wet/wetting.hpp"
 
@@ -31,6 +32,11 @@ void move(const Model& m, Bridge& b, int s, int dir) {
     if (s == 0) b.image += dir > 0 ? Eigen::Vector2i(-sh) : sh;
     else b.image += dir > 0 ? sh : Eigen::Vector2i(-sh);
     k += dir;
+}
+
+// Side s of b: its home segment's index on the fiber and the fiber's number of segments.
+std::pair<int, int> home_on_fiber(const Model& m, const Bridge& b, int s) {
+    return {s == 0 ? b.k1 : b.k2, static_cast<int>(m.chains[s == 0 ? b.f1 : b.f2].segments.size())};
 }
 
 using Key = std::array<int, 6>;  // a segment pair
@@ -210,8 +216,7 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
             if (!cp.defined) break;
             bool moved = false;
             for (int s = 0; s < 2 && !moved && alive; ++s) {
-                const int k = s == 0 ? b.k1 : b.k2;
-                const int nseg = static_cast<int>(m.chains[s == 0 ? b.f1 : b.f2].segments.size());
+                const auto [k, nseg] = home_on_fiber(m, b, s);
                 // A move needs the crossing a margin past the node (hysteresis): the element of the new home measures
                 // the other fiber's blend against a different segment line, so where both fibers' blend zones overlap
                 // the move is not exactly energy neutral, and a bridge moved at z = 0+ could slide back and forth
@@ -278,8 +283,7 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
             const CrossingPosition cp = crossing_position(el, element_coordinates(el, x, B));
             bool near_end = false;
             for (int s = 0; s < 2 && cp.defined; ++s) {
-                const int k = s == 0 ? c.k1 : c.k2;
-                const int nseg = static_cast<int>(m.chains[s == 0 ? c.f1 : c.f2].segments.size());
+                const auto [k, nseg] = home_on_fiber(m, c, s);
                 near_end = near_end || (k == 0 && cp.z[s][0] < opt.move_margin * cp.delta[s][0]) ||
                            (k + 1 == nseg && cp.z[s][1] > -opt.move_margin * cp.delta[s][1]);
             }
@@ -309,7 +313,6 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
     };
     std::vector<std::vector<std::array<int, 7>>> history{signature(bridges)};  // the set after each round (0: start)
     FiberPairs frozen;
-    int freezes = 0;
     for (int round = 1; round <= opt.max_rounds; ++round) {
         r.rounds = round;
         WetEnergy W(dry, F, bridges, params);
@@ -373,12 +376,11 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             // Break the cycle: the fiber pairs of the toggling bridges keep their current bridges from here on (no
             // moves, ruptures or new bridges between them), and the rounds go on. What follows is an equilibrium of
             // the energy with that set; the pairs are reported (frozen_pairs).
-            size_t before = frozen.size();
+            const size_t before = frozen.size();
             for (const auto& d : diff) frozen.insert({std::min(d[0], d[1]), std::max(d[0], d[1])});
-            if (freezes < opt.max_freezes && frozen.size() > before) {
-                ++freezes;
+            if (r.cycles_broken < opt.max_freezes && frozen.size() > before) {
+                ++r.cycles_broken;
                 r.frozen_pairs = static_cast<int>(frozen.size());
-                r.cycles_broken = freezes;
                 if (opt.verbose) std::fprintf(stderr, "wet round %2d: cycling (%s): fiber pairs frozen\n", round, what.c_str());
                 history.assign(1, sig);
                 continue;

@@ -50,19 +50,32 @@ Drag drag(const NetworkEnergy& e, Eigen::VectorXd q, std::vector<Bridge>& bridge
     }
     return d;
 }
+// Fiber 1 along x from 10 to 20 (nodes at integers), kinked by 15 deg at x = 13; fiber 2 at 60 deg crosses it at 12.5.
+struct KinkedCrossing {
+    Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.25, 1.5, 60, 1, 0.45}}, 3);
+    Model m = model_of(net);
+    Eigen::VectorXd pos = kinked(m);
+
+    static Eigen::VectorXd kinked(const Model& m) {
+        Eigen::VectorXd pos = m.x;
+        const double kink = 15 * M_PI / 180;
+        for (int n : m.chains[0].nodes) {
+            const double x = pos[2 * n] - 13, y = pos[2 * n + 1] - 15;
+            if (x > 1e-9)
+                pos[2 * n] = 13 + std::cos(kink) * x - std::sin(kink) * y,
+                pos[2 * n + 1] = 15 + std::sin(kink) * x + std::cos(kink) * y;
+        }
+        return pos;
+    }
+};
 }  // namespace
 
 TEST_CASE("active set: a bridge dragged across a kinked node moves without an energy jump", "[wet][events]") {
-    // Fiber 1 along x from 10 to 20 (nodes at integers), kinked by 15 deg at x = 13; fiber 2 at 60 deg crosses at 12.5.
-    const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.25, 1.5, 60, 1, 0.45}}, 3);
-    const Model m = model_of(net);
+    const KinkedCrossing k;
+    const Network& net = k.net;
+    const Model& m = k.m;
     NetworkEnergy e(m);
-    Eigen::VectorXd pos = m.x;
-    const double kink = 15 * M_PI / 180;
-    for (int n : m.chains[0].nodes) {
-        const double x = pos[2 * n] - 13, y = pos[2 * n + 1] - 15;
-        if (x > 1e-9) pos[2 * n] = 13 + std::cos(kink) * x - std::sin(kink) * y, pos[2 * n + 1] = 15 + std::sin(kink) * x + std::cos(kink) * y;
-    }
+    const Eigen::VectorXd& pos = k.pos;
     Eigen::VectorXd q = e.dofs(pos);
     std::vector<Bridge> bridges = wet_crossings(net, m, e.positions(q, I2), m.box.B0(), {});
     REQUIRE(bridges.size() == 1);
@@ -83,15 +96,11 @@ TEST_CASE("active set: a bridge dragged across a kinked node moves without an en
 TEST_CASE("active set: a bridge moves only a margin past a node (hysteresis against ping-pong)", "[wet][events]") {
     // As above: fiber 1 kinked at x = 13 (segments of 1: blend half-width delta = 0.25), fiber 2 at 60 deg crossing at
     // 12.5 and dragged along x, so the crossing moves with it. move_margin = 0.1: a move needs 0.025 past the node.
-    const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.25, 1.5, 60, 1, 0.45}}, 3);
-    const Model m = model_of(net);
+    const KinkedCrossing k;
+    const Network& net = k.net;
+    const Model& m = k.m;
     NetworkEnergy e(m);
-    Eigen::VectorXd pos = m.x;
-    const double kink = 15 * M_PI / 180;
-    for (int n : m.chains[0].nodes) {
-        const double x = pos[2 * n] - 13, y = pos[2 * n + 1] - 15;
-        if (x > 1e-9) pos[2 * n] = 13 + std::cos(kink) * x - std::sin(kink) * y, pos[2 * n + 1] = 15 + std::sin(kink) * x + std::cos(kink) * y;
-    }
+    const Eigen::VectorXd& pos = k.pos;
     const Eigen::VectorXd q = e.dofs(pos);
     std::vector<Bridge> bridges = wet_crossings(net, m, e.positions(q, I2), m.box.B0(), {});
     REQUIRE(bridges.size() == 1);
