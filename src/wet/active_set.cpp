@@ -390,10 +390,10 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             break;
         }
         history.push_back(sig);
-        if (round == opt.max_rounds)
-            r.message = "no stable bridge set after " + std::to_string(round) + " rounds (last solve: " +
-                        to_string(r.last.status) + ")";
     }
+    if (!r.stable && !r.cycling && r.message.empty())  // every round used, the last one possibly breaking a cycle
+        r.message = "no stable bridge set after " + std::to_string(r.rounds) + " rounds (last solve: " +
+                    to_string(r.last.status) + ")";
     r.bridges = std::move(bridges);
     return r;
 }

@@ -251,6 +251,17 @@ TEST_CASE("active set: a bridge set that repeats is reported as cycling", "[wet]
     CHECK(r2.cycling);
     CHECK(!r2.stable);
     CHECK(r2.rounds < opt2.max_rounds);
+
+    // A cycle broken in the last allowed round still ends with a message saying the rounds ran out.
+    Alternating solver3(moved(e, q0, 1, -2, 0), moved(e, q0, 1, -1, 0));
+    Eigen::VectorXd q3 = q0;
+    ActiveSetOptions opt3;
+    opt3.form_new = false;
+    opt3.max_rounds = 3;  // the repeat is found (and broken) in round 3
+    const ActiveSetResult r3 = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver3, q3, opt3);
+    CHECK(r3.cycles_broken == 1);
+    CHECK(!r3.stable);
+    CHECK(r3.message == "no stable bridge set after 3 rounds (last solve: converged)");
 }
 
 TEST_CASE("active set: bridges of a frozen fiber pair are kept as they are", "[wet][events]") {
