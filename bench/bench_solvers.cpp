@@ -184,6 +184,7 @@ public:
     DeadlineSolver(std::string name, SolverOptions opt, double seconds)
         : name_(std::move(name)), opt_(opt), seconds_(seconds), t0_(std::chrono::steady_clock::now()) {}
     std::string name() const override { return name_; }
+    SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override {
         const double left = seconds_ - seconds_since(t0_);
         if (left <= 0) {

@@ -2,8 +2,9 @@
 # Wet relaxation over network seeds (issue 6): the wet path is sensitive to round-off and events, so one network is
 # not a benchmark. Runs build/bench_wet for seeds 1..S and prints one line per seed plus the totals.
 #   [OUT=runs.jsonl] bench/run_wet_seeds.sh BUILD_DIR [N=100] [S=6] [beta=0.01] [scheme=seed] [move_margin=0.1]
+#                                            [round_iterations=10]
 set -euo pipefail
-B=${1:?build dir}; N=${2:-100}; S=${3:-6}; BETA=${4:-0.01}; SCHEME=${5:-seed}; MARGIN=${6:-0.1}
+B=${1:?build dir}; N=${2:-100}; S=${3:-6}; BETA=${4:-0.01}; SCHEME=${5:-seed}; MARGIN=${6:-0.1}; ROUNDIT=${7:-10}
 for s in $(seq 1 "$S"); do
-  OPENBLAS_NUM_THREADS=1 "$B/bench_wet" "$N" 10 "$BETA" 30 500 "$SCHEME" "$s" "$MARGIN"
+  OPENBLAS_NUM_THREADS=1 "$B/bench_wet" "$N" 10 "$BETA" 200 500 "$SCHEME" "$s" "$MARGIN" "$ROUNDIT"
 done | tee "${OUT:-/dev/null}" | /usr/bin/python3 "$(dirname "$0")/summarize_wet_seeds.py"

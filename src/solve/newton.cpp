@@ -78,6 +78,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
     r.solver = name();
     history_.clear();
     rungs_.clear();
+    shifts_.clear();
     const int n = f.size();
     if (q.size() != n) throw std::logic_error("newton: start vector has the wrong size");
 
@@ -90,6 +91,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
     int start_rung = 0;
     std::vector<double> energies;
     double mu_lm = -1;  // Levenberg-Marquardt shift, adapted from the model agreement of each step
+    double dm_last = 0;  // mean diag of the last iteration's H (the shift is kept relative to it)
     bool projected = false;  // what H currently holds
     for (int it = 0;; ++it) {
         // Assemble f, g, H at q: exact unless the last iteration needed the projected rungs.
@@ -150,7 +152,8 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
 
         // The ladder: find a descent direction.
         const double dm = std::max(mean_diag(H), std::numeric_limits<double>::min());
-        if (mu_lm < 0) mu_lm = kMuStart * dm;
+        if (mu_lm < 0) mu_lm = (opt_.warm_start && shift_rel_ > 0 ? shift_rel_ : kMuStart) * dm;
+        dm_last = dm;
         const double mu = std::max(kMuFloor * dm, mu_lm);
         const double gnorm = g.norm();
         int rung = -1;
@@ -232,6 +235,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         }
         r.timings.line_search += since(tl);
         rungs_.push_back(rung);
+        shifts_.push_back(rung <= 2 ? shift : 0.0);
         if (opt_.verbose)
             std::fprintf(stderr, "newton %4d  E = %.15e  max|g| = %.3e  floor %.1e  rung %d  shift %.2e  alpha %.3e\n", it, fq,
                          gmax, floor, rung, shift, accepted ? alpha : 0.0);
@@ -256,6 +260,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         start_rung = std::max(0, std::min(rung, 2) - 1);
     }
     r.timings.total = since(t_start);
+    if (mu_lm > 0 && dm_last > 0) shift_rel_ = mu_lm / dm_last;
     if (opt_.verbose)
         std::fprintf(stderr, "newton: %s after %d iterations, %d factorizations, max|g| = %.3e, %.3f s\n",
                      to_string(r.status).c_str(), r.iterations, r.factorizations, r.grad_max, r.timings.total);

@@ -313,13 +313,30 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
     };
     std::vector<std::vector<std::array<int, 7>>> history{signature(bridges)};  // the set after each round (0: start)
     FiberPairs frozen;
+    // The solver's options, restored on return; rounds are capped below its budget while the set keeps changing.
+    SolverOptions& so = solver.options();
+    const int budget = so.max_iter;
+    struct Restore {
+        SolverOptions& so;
+        SolverOptions saved;
+        ~Restore() { so = saved; }
+    } restore{so, so};
+    // With beta = 0 the bridges carry no energy: one uncapped solve is the dry one, bit for bit (issue 6).
+    const bool cap = opt.round_iterations > 0 && opt.round_iterations < budget && params.beta > 0;
+    bool capped = cap;
     for (int round = 1; round <= opt.max_rounds; ++round) {
         r.rounds = round;
         WetEnergy W(dry, F, bridges, params);
         double t0 = now();
+        so.max_iter = capped ? opt.round_iterations : budget;
+        so.warm_start = round > 1 || restore.saved.warm_start;  // later rounds resume the solve (Newton: its shift)
         r.last = solver.minimize(W, q);
         r.seconds_solve += now() - t0;
         r.solver_iterations += r.last.iterations;
+        r.factorizations += r.last.factorizations;
+        r.timings.assembly += r.last.timings.assembly, r.timings.factorization += r.last.timings.factorization;
+        r.timings.solve += r.last.timings.solve, r.timings.line_search += r.last.timings.line_search;
+        r.timings.total += r.last.timings.total;
         // An iteration limit is not final: large motions (a fiber zipping onto another) make the set stale long before
         // the solve ends, so the set is updated and the solve continues with it. Other failures end the loop.
         const bool limit = r.last.status == SolveStatus::IterationLimit;
@@ -357,6 +374,8 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             break;
         }
         const auto sig = signature(bridges);
+        // The next round is capped only if this one changed the set: once it has settled, the solve finishes.
+        capped = cap && sig != history.back();
         const auto again = std::find(history.begin(), history.end(), sig);
         if (!limit && again != history.end()) {
             // Name what toggles: the bridges in which the sets after the repeated round and after the next differ.

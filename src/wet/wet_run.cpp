@@ -69,7 +69,10 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     first.form_new = false;
     update_bridges(dry, run.dry.q, F, bridges, first);
     run.wet.q = run.dry.q;
-    run.active = relax_wet(dry, F, opt.params, bridges, *solver, run.wet.q, opt.active_set);
+    // Rounds are capped in Newton iterations (active_set.hpp); first-order solvers' iterations are cheap and many.
+    ActiveSetOptions as = opt.active_set;
+    if (opt.solver != "newton") as.round_iterations = 0;
+    run.active = relax_wet(dry, F, opt.params, bridges, *solver, run.wet.q, as);
     run.seconds_wet_solve = run.active.seconds_solve;
     run.seconds_events = run.active.seconds_events;
     run.wet.converged = run.active.last.converged();
@@ -88,7 +91,7 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     }
     if (opt.free_box.enabled) {
         if (run.wet.converged && run.active.stable) {
-            run.free_box = free_box(dry, F, opt.params, run.wet.q, run.active.bridges, *solver, opt.active_set,
+            run.free_box = free_box(dry, F, opt.params, run.wet.q, run.active.bridges, *solver, as,
                                     opt.free_box);
             const Eigen::Matrix2d Bf = run.free_box.F * m.box.B0();
             const Eigen::VectorXd xf = dry.positions(run.free_box.q, run.free_box.F);

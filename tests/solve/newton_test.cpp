@@ -291,3 +291,78 @@ TEST_CASE("newton: an indefinite Hessian gets an escalated shift on the exact He
     for (int rung : newton.rungs()) projected += rung >= 1;
     CHECK(projected == 0);
 }
+
+namespace {
+// f = sum_i cosh(x_i - c_i) + (x_i - x_{i+1})^2 / 2: smooth and strictly convex, so Newton's steps from afar are full
+// and well predicted.
+class Convex : public Objective {
+public:
+    explicit Convex(int n) : n_(n) {
+        Eigen::VectorXd g;
+        hessian(Eigen::VectorXd::Zero(n), g, pattern_, false);
+        pattern_.coeffs().setZero();
+    }
+    int size() const override { return n_; }
+    double value(const Eigen::VectorXd& q) override {
+        Eigen::VectorXd g;
+        return gradient(q, g);
+    }
+    double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override {
+        g.setZero(n_);
+        double f = 0;
+        for (int i = 0; i < n_; ++i) {
+            f += std::cosh(q[i] - c(i)), g[i] += std::sinh(q[i] - c(i));
+            if (i + 1 < n_) {
+                const double d = q[i] - q[i + 1];
+                f += 0.5 * d * d, g[i] += d, g[i + 1] -= d;
+            }
+        }
+        return f;
+    }
+    double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool) override {
+        const double f = gradient(q, g);
+        std::vector<Eigen::Triplet<double>> t;
+        for (int i = 0; i < n_; ++i) {
+            t.emplace_back(i, i, std::cosh(q[i] - c(i)) + (i > 0) + (i + 1 < n_));
+            if (i + 1 < n_) t.emplace_back(i, i + 1, -1.0);
+        }
+        H.resize(n_, n_);
+        H.setFromTriplets(t.begin(), t.end());
+        H.makeCompressed();
+        return f;
+    }
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
+
+private:
+    static double c(int i) { return std::sin(1.0 + i); }
+    int n_;
+    Eigen::SparseMatrix<double> pattern_;  // upper triangle
+};
+}  // namespace
+
+TEST_CASE("newton: warm_start resumes with the shift the previous solve adapted", "[newton]") {
+    // Full, well-predicted steps cut the shift 10x each, so after a few iterations it is far below the cold start
+    // (1e-8 x mean diag). A warm-started resume begins there; a cold one begins at 1e-8 x mean diag again.
+    Convex obj(20);
+    const Eigen::VectorXd q0 = Eigen::VectorXd::Constant(20, 3.0);
+    SolverOptions opt;
+    opt.max_iter = 3;
+    NewtonSolver cold(opt), warm(opt);
+    Eigen::VectorXd qc = q0, qw = q0;
+    REQUIRE(cold.minimize(obj, qc).status == SolveStatus::IterationLimit);
+    REQUIRE(warm.minimize(obj, qw).status == SolveStatus::IterationLimit);
+    REQUIRE(cold.rungs()[0] == 0);
+    const double first = cold.shifts()[0];
+    REQUIRE(cold.shifts().back() < 1e-1 * first);  // the shift fell while the steps were good
+    REQUIRE((qc.array() == qw.array()).all());
+    Eigen::VectorXd g;
+    Eigen::SparseMatrix<double> H = obj.hessian_pattern();
+    obj.hessian(qc, g, H, false);
+    const double cold_start = 1e-8 * H.diagonal().cwiseAbs().mean();
+    warm.options().warm_start = true;
+    cold.minimize(obj, qc);
+    warm.minimize(obj, qw);
+    INFO("cold restart " << cold.shifts()[0] << ", warm " << warm.shifts()[0] << ", cold start " << cold_start);
+    CHECK(cold.shifts()[0] == Approx(cold_start).epsilon(1e-12));
+    CHECK(warm.shifts()[0] < 1e-2 * cold_start);
+}

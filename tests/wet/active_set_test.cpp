@@ -204,6 +204,7 @@ class Alternating : public Solver {
 public:
     Alternating(Eigen::VectorXd a, Eigen::VectorXd b) : s_{std::move(a), std::move(b)} {}
     std::string name() const override { return "alternating"; }
+    SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective&, Eigen::VectorXd& q) override {
         q = s_[k_++ % 2];
         SolveResult r;
@@ -215,6 +216,7 @@ public:
 private:
     Eigen::VectorXd s_[2];
     int k_ = 0;
+    SolverOptions opt_;
 };
 }  // namespace
 

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "fibernet/mechanics/equilibrium.hpp"  // affine_start
+#include "fibernet/solve/newton.hpp"
 #include "fibernet/wet/active_set.hpp"
 #include "wet_fixtures.hpp"
 
@@ -63,4 +64,70 @@ TEST_CASE("wet relaxation: the active-set loop terminates and reports", "[wet][r
                 CHECK(update_bridges(e, q, Eigen::Matrix2d::Identity(), b).total() == 0);
             }
         }
+}
+
+namespace {
+// Passes each call to Newton with the options the loop set, and records them.
+class Recording : public Solver {
+public:
+    explicit Recording(SolverOptions o) : opt_(o), inner_(o) {}
+    std::string name() const override { return "newton"; }
+    SolverOptions& options() override { return opt_; }
+    SolveResult minimize(Objective& f, Eigen::VectorXd& q) override {
+        caps.push_back(opt_.max_iter);
+        warm.push_back(opt_.warm_start);
+        inner_.options() = opt_;
+        const SolveResult r = inner_.minimize(f, q);
+        iterations.push_back(r.iterations);
+        return r;
+    }
+    std::vector<int> caps, iterations;
+    std::vector<bool> warm;
+
+private:
+    SolverOptions opt_;
+    NewtonSolver inner_;
+};
+}  // namespace
+
+TEST_CASE("wet relaxation: rounds are capped while the bridge set changes, then solved to the end", "[wet][relax]") {
+    const Network net = mikado(2.5, 6, 0.8, 2);
+    const Model m = model_of(net, 10);
+    NetworkEnergy e(m);
+    WetParams p;
+    p.beta = 0.5;
+    const auto initial = wet_crossings(net, m, m.x, m.box.B0(), {});
+    for (int cap : {4, 0}) {
+        SolverOptions so;
+        so.tol = 1e-9, so.max_iter = 300;
+        Recording s(so);
+        ActiveSetOptions opt;
+        opt.round_iterations = cap;
+        Eigen::VectorXd q = e.dofs(m.x);
+        const ActiveSetResult r = relax_wet(e, Eigen::Matrix2d::Identity(), p, initial, s, q, opt);
+        INFO("cap " << cap << ": " << r.message << ", rounds " << r.rounds);
+        REQUIRE(r.stable);
+        CHECK(r.last.converged());
+        std::vector<Bridge> b = r.bridges;
+        CHECK(update_bridges(e, q, Eigen::Matrix2d::Identity(), b).total() == 0);
+        // The solver's own options are back as they were.
+        CHECK(s.options().max_iter == 300);
+        CHECK(!s.options().warm_start);
+        REQUIRE(s.caps.size() == static_cast<size_t>(r.rounds));
+        CHECK(!s.warm[0]);
+        int capped = 0;
+        for (int k = 0; k < r.rounds; ++k) {
+            INFO("round " << k + 1);
+            if (k > 0) CHECK(s.warm[k]);  // later rounds resume the solve
+            if (cap == 0) {
+                CHECK(s.caps[k] == 300);
+                continue;
+            }
+            // Round 1 is capped; a later one is capped exactly when the round before it changed the set.
+            const bool changed = k == 0 || r.per_round[k - 1].total() + r.per_round[k - 1].locked > 0;
+            CHECK(s.caps[k] == (changed ? cap : 300));
+            capped += s.caps[k] == cap && s.iterations[k] == cap;
+        }
+        if (cap > 0) CHECK(capped >= 1);  // the cap did stop a round here
+    }
 }

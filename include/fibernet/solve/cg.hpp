@@ -28,6 +28,7 @@ class CgSolver : public Solver {
 public:
     CgSolver(const SolverOptions& opt, const CgParams& p = {});
     std::string name() const override { return "cg"; }
+    SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
 
 private:

@@ -39,6 +39,7 @@ class FireSolver : public Solver {
 public:
     FireSolver(const SolverOptions& opt, const FireParams& p = {});
     std::string name() const override { return "fire"; }
+    SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
 
 private:

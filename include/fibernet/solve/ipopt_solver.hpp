@@ -29,6 +29,7 @@ class IpoptSolver : public Solver {
 public:
     IpoptSolver(const SolverOptions& opt, const IpoptParams& p = {});
     std::string name() const override { return "ipopt"; }
+    SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
 
 private:

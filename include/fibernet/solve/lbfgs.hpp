@@ -36,6 +36,7 @@ class LbfgsSolver : public Solver {
 public:
     LbfgsSolver(const SolverOptions& opt, const LbfgsParams& p = {});
     std::string name() const override { return p_.hessian_h0 ? "lbfgs-hessian" : "lbfgs"; }
+    SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
 
 private:

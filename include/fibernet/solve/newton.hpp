@@ -3,9 +3,12 @@
 //
 // The step ladder (docs/moduli.md, "Newton ladder"), tried in order at each iteration until a factorization
 // succeeds and the direction passes the descent check g.d < -1e-12 |g| |d|:
-//   0. exact H + mu I          mu = min(|g|_inf, mu_max) (regularized Newton: keeps quadratic convergence on
-//                              singular H — translations, floppy clusters — because mu -> 0 with |g|), floored at
-//                              mu_floor = 1e-13 * mean diag(H) (round-off scale of a null pivot);
+//   0. exact H + mu I          mu: a Levenberg-Marquardt shift, 1e-8 * mean diag(H) at the start (or the previous
+//                              solve's with SolverOptions::warm_start), cut 10x after a full step the quadratic model
+//                              predicted well (so mu -> 0 and convergence is quadratic, also on singular H:
+//                              translations, floppy clusters), raised after backtracking; floored at
+//                              mu_floor = 1e-13 * mean diag(H) (round-off scale of a null pivot). If H + mu I does
+//                              not factor, the shift on the exact H is raised 4x at a time up to 0.2 mean diag;
 //   1. per-element PSD-projected H + mu I  (buckled or compressed segments make H indefinite);
 //   2. projected H + lambda I, lambda = 1e-8 * mean diag(H) * 10^j, j = 0..10;
 //   3. steepest descent d = -g.
@@ -25,12 +28,14 @@ class NewtonSolver : public Solver {
 public:
     explicit NewtonSolver(SolverOptions opt) : opt_(opt) {}
     std::string name() const override { return "newton"; }
+    SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
 
     // max|g| after each iteration of the last minimize() (index 0: the start), for convergence-rate checks.
     const std::vector<double>& history() const { return history_; }
-    // The rung of the ladder each iteration used (0..3).
+    // The rung of the ladder each iteration used (0..3), and the shift it factored with (0 on rung 3).
     const std::vector<int>& rungs() const { return rungs_; }
+    const std::vector<double>& shifts() const { return shifts_; }
     // The CHOLMOD wrapper of the last minimize(), symbolically analyzed for that objective's Hessian pattern (kept
     // across calls: a strain sweep or the modulus after an equilibrium reuses the analysis); null before any call.
     CholmodLLT* factorization() { return llt_.get(); }
@@ -41,8 +46,10 @@ private:
     SolverOptions opt_;
     std::vector<double> history_;
     std::vector<int> rungs_;
+    std::vector<double> shifts_;
     std::unique_ptr<CholmodLLT> llt_;
     Eigen::SparseMatrix<double> analyzed_;  // the pattern llt_ was analyzed for
+    double shift_rel_ = -1;                  // the last minimize()'s final shift / mean diag (for warm_start)
 };
 
 }  // namespace fibernet

@@ -32,6 +32,7 @@ class NloptSolver : public Solver {
 public:
     NloptSolver(NloptMethod method, const SolverOptions& opt, const NloptParams& p = {});
     std::string name() const override;
+    SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
 
 private:

@@ -14,6 +14,8 @@ struct SolverOptions {
     int max_iter = 500;      // iteration budget (solver-specific meaning: Newton steps, L-BFGS iterations, ...)
     double max_seconds = 0;  // wall-time budget, 0 = none
     bool verbose = false;    // progress to stderr
+    bool warm_start = false; // start from the state the previous minimize() adapted (Newton: its shift), for a caller
+                             // that resumes an interrupted solve of a slightly changed objective; others ignore it
 };
 
 class Solver {
@@ -23,6 +25,9 @@ public:
     // Minimizes f starting from q, overwriting q with the final state. The result's status says whether q is
     // an equilibrium; callers must not report an unconverged q as one.
     virtual SolveResult minimize(Objective& f, Eigen::VectorXd& q) = 0;
+    // The options the next minimize() uses; a caller may change them between calls (the wet active-set loop caps
+    // the iterations of a round while its bridge set is still changing).
+    virtual SolverOptions& options() = 0;
 };
 
 // Throws InputError naming the solver if unknown.

@@ -39,7 +39,13 @@ struct WetEvents {
 };
 
 struct ActiveSetOptions {
-    int max_rounds = 30;
+    int max_rounds = 200;
+    // While the set keeps changing, a round's solve stops after this many solver iterations and the set is updated
+    // (0: every round is solved to convergence). Zipping moves fibers far, so a set goes stale long before a solve
+    // of it converges: solving it to the end was 2/3 of the Newton iterations (docs/wet.md, "Rounds"). A round that
+    // leaves the set unchanged lifts the cap for the next one. The default suits Newton; run_wet lifts it for
+    // first-order solvers, whose iterations are cheap and many.
+    int round_iterations = 10;
     bool form_new = true;        // give new crossings and new contacts bridges
     double contact_distance = 0;  // seed units; 0: the fiber diameter 2 r = 2 ls / a
     double contact_angle_deg = 10;
@@ -53,7 +59,8 @@ struct ActiveSetResult {
     SolveResult last;              // the last solve (its status says whether q is an equilibrium of the final set)
     WetEvents events;              // summed over rounds
     std::vector<WetEvents> per_round;
-    int rounds = 0, solver_iterations = 0;
+    int rounds = 0, solver_iterations = 0, factorizations = 0;
+    SolveTimings timings;          // the solver's time split, summed over rounds
     bool stable = false;           // the last round changed nothing: q is an equilibrium with a consistent set
     bool cycling = false;          // a bridge set repeated after max_freezes cycles were broken
     int cycles_broken = 0;         // cycles broken by freezing the toggling fiber pairs
