@@ -2,7 +2,7 @@
 // scheme) relaxed dry, wetted at all crossings and relaxed under capillary load with mobile bridges.
 // Prints one JSON line per run with the time split: dry Newton, wet Newton, event handling, pore analysis.
 //   bench_wet [N=1000] [q=10] [beta=0.01] [max_rounds=200] [newton_max_iter=500] [scheme=seed] [seed=1] [move_margin=0.1]
-//             [round_iterations=10]
+//             [round_iterations=0] [warm_start=1]
 // The "newton" block sums the wet solves' time split over all rounds.
 #include <chrono>
 #include <cmath>
@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
     const unsigned seed = argc > 7 ? static_cast<unsigned>(std::atoi(argv[7])) : 1u;
     const double move_margin = argc > 8 ? std::atof(argv[8]) : ActiveSetOptions{}.move_margin;
     const int round_iterations = argc > 9 ? std::atoi(argv[9]) : ActiveSetOptions{}.round_iterations;
+    const bool warm_start = argc > 10 ? std::atoi(argv[10]) != 0 : ActiveSetOptions{}.warm_start;
     const auto t0 = std::chrono::steady_clock::now();
     MikadoParams mp;
     mp.q = q, mp.pl = 0.5, mp.seed = seed;
@@ -41,6 +42,7 @@ int main(int argc, char** argv) {
     opt.active_set.max_rounds = rounds;
     opt.active_set.move_margin = move_margin;
     opt.active_set.round_iterations = round_iterations;
+    opt.active_set.warm_start = warm_start;
     opt.active_set.verbose = std::getenv("BENCH_VERBOSE") != nullptr;  // a line per active-set round on stderr
     opt.solver_options.tol = 1e-8;
     opt.solver_options.max_iter = max_iter;
@@ -48,11 +50,11 @@ int main(int argc, char** argv) {
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf(
         "{\"fibers\": %zu, \"q\": %g, \"beta\": %g, \"nodes\": %d, \"bridges_initial\": %zu, \"bridges_final\": %zu, "
-        "\"rounds\": %d, \"stable\": %s, \"cycling\": %s, \"cycles_broken\": %d, \"newton_iterations\": %d, \"events\": %d, "
+        "\"rounds\": %d, \"E_total\": %.10g, \"E_capillary\": %.10g, \"stable\": %s, \"cycling\": %s, \"cycles_broken\": %d, \"newton_iterations\": %d, \"events\": %d, "
         "\"seconds\": {\"build\": %.3f, \"dry\": %.3f, \"wet_newton\": %.3f, \"events\": %.3f, \"pores\": %.3f, "
         "\"total\": %.3f}, \"newton\": {\"factorizations\": %d, \"assembly\": %.3f, "
         "\"factorization\": %.3f, \"solve\": %.3f, \"line_search\": %.3f, \"total\": %.3f}, \"message\": \"%s\"}\n",
-        net.fibers.size(), q, beta, m.num_nodes(), r.initial_bridges.size(), r.active.bridges.size(), r.active.rounds,
+        net.fibers.size(), q, beta, m.num_nodes(), r.initial_bridges.size(), r.active.bridges.size(), r.active.rounds, r.wet.energy.total(), r.wet.energy.capillary,
         r.active.stable ? "true" : "false", r.active.cycling ? "true" : "false", r.active.cycles_broken, r.active.solver_iterations,
         r.active.events.total(), t_build, r.seconds_dry, r.seconds_wet_solve, r.seconds_events, r.seconds_pores, total,
         r.active.factorizations, r.active.timings.assembly, r.active.timings.factorization, r.active.timings.solve,

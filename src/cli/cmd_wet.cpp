@@ -160,6 +160,8 @@ void register_wet(CLI::App& app) {
         opt.solver_options.tol = s.solver.tol, opt.solver_options.max_iter = s.solver.max_iter;
         opt.solver_options.verbose = w->verbose;
         opt.active_set.verbose = w->verbose || !w->quiet;
+        opt.active_set.max_rounds = s.wet.max_rounds;
+        opt.active_set.round_iterations = s.wet.round_iterations;
         if (w->verbose && w->quiet) throw InputError("--verbose and --quiet contradict each other");
         opt.moduli = !w->no_moduli;
         make_solver(opt.solver, opt.solver_options);  // an unknown solver is an InputError before any work

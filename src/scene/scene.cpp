@@ -22,6 +22,8 @@ void Scene::check() const {
     if (wet.crossings != "all" && wet.crossings != "free" && wet.crossings != "fraction")
         throw InputError(source + ": [wet].crossings = '" + wet.crossings + "' is unknown (expected all, free or fraction)");
     check_value(wet.free_box_tol > 0, wet.free_box_tol, source, "[wet].free_box_tol", "must be > 0");
+    check_value(wet.max_rounds >= 1, wet.max_rounds, source, "[wet].max_rounds", "must be >= 1");
+    check_value(wet.round_iterations >= 0, wet.round_iterations, source, "[wet].round_iterations", "must be >= 0");
     if (wet.free_box_shape != "full" && wet.free_box_shape != "isotropic")
         throw InputError(source + ": [wet].free_box_shape = '" + wet.free_box_shape +
                          "' is unknown (expected isotropic or full)");
@@ -173,6 +175,8 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         r.get("free_box", s.wet.free_box);
         r.get("free_box_shape", s.wet.free_box_shape);
         r.get("free_box_tol", s.wet.free_box_tol);
+        r.get("max_rounds", s.wet.max_rounds);
+        r.get("round_iterations", s.wet.round_iterations);
         r.finish();
     }
     s.check();

@@ -324,12 +324,13 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
     // With beta = 0 the bridges carry no energy: one uncapped solve is the dry one, bit for bit (issue 6).
     const bool cap = opt.round_iterations > 0 && opt.round_iterations < budget && params.beta > 0;
     bool capped = cap;
+    bool resume = false;  // the last round was cut at round_iterations: the next one resumes its solve
     for (int round = 1; round <= opt.max_rounds; ++round) {
         r.rounds = round;
         WetEnergy W(dry, F, bridges, params);
         double t0 = now();
         so.max_iter = capped ? opt.round_iterations : budget;
-        so.warm_start = round > 1 || restore.saved.warm_start;  // later rounds resume the solve (Newton: its shift)
+        so.warm_start = (resume && opt.warm_start) || restore.saved.warm_start;  // Newton: keep its adapted shift
         r.last = solver.minimize(W, q);
         r.seconds_solve += now() - t0;
         r.solver_iterations += r.last.iterations;
@@ -340,6 +341,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         // An iteration limit is not final: large motions (a fiber zipping onto another) make the set stale long before
         // the solve ends, so the set is updated and the solve continues with it. Other failures end the loop.
         const bool limit = r.last.status == SolveStatus::IterationLimit;
+        resume = capped && limit;
         if (!r.last.converged() && !limit) {
             r.message = "round " + std::to_string(round) + ": solver " + to_string(r.last.status) + " (" + r.last.message + ")";
             break;
@@ -374,8 +376,10 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             break;
         }
         const auto sig = signature(bridges);
-        // The next round is capped only if this one changed the set: once it has settled, the solve finishes.
-        capped = cap && sig != history.back();
+        // The next round is capped only if this one changed the set to one not seen before: once it has settled, or
+        // toggles (a bridge moving back and forth while the rest still moves), the solve finishes, and a repeat
+        // after a finished solve is a cycle (below). Without this a 3000-fiber run toggled 3 bridges for 250 rounds.
+        capped = cap && std::find(history.begin(), history.end(), sig) == history.end();
         const auto again = std::find(history.begin(), history.end(), sig);
         if (!limit && again != history.end()) {
             // Name what toggles: the bridges in which the sets after the repeated round and after the next differ.

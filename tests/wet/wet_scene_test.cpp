@@ -20,6 +20,10 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
     CHECK(f.wet.free_box);
     CHECK(f.wet.free_box_shape == "full");
     CHECK(f.wet.free_box_tol == 1e-4);
+    const Scene r = parse_scene("[wet]\nmax_rounds = 50\nround_iterations = 0\n", "r.toml");
+    CHECK(r.wet.max_rounds == 50);
+    CHECK(r.wet.round_iterations == 0);
+    CHECK(parse_scene("", "empty.toml").wet.round_iterations == 0);
     struct Bad {
         std::string toml, needle;
     };
@@ -30,6 +34,9 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
                          Bad{"[wet]\nfree_box = 1\n", "[wet].free_box"},
                          Bad{"[wet]\nfree_box_shape = \"round\"\n", "[wet].free_box_shape = 'round'"},
                          Bad{"[wet]\nfree_box_tol = -1\n", "[wet].free_box_tol = -1"},
+                         Bad{"[wet]\nmax_rounds = 0\n", "[wet].max_rounds = 0"},
+                         Bad{"[wet]\nround_iterations = -1\n", "[wet].round_iterations = -1"},
+                         Bad{"[wet]\nround_iterations = 2.5\n", "[wet].round_iterations"},
                          Bad{"[wet]\nlaw = \"/nonexistent/law.txt\"\n", "/nonexistent/law.txt"}}) {
         INFO(b.toml);
         try {
