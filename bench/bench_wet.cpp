@@ -2,8 +2,9 @@
 // scheme) relaxed dry, wetted at all crossings and relaxed under capillary load with mobile bridges.
 // Prints one JSON line per run with the time split: dry Newton, wet Newton, event handling, pore analysis.
 //   bench_wet [N=1000] [q=10] [beta=0.01] [max_rounds=200] [newton_max_iter=500] [scheme=seed] [seed=1] [move_margin=0.1]
-//             [round_iterations=0] [warm_start=1]
+//             [round_iterations=10] [warm_start=1]
 // The "newton" block sums the wet solves' time split over all rounds.
+// Environment: BENCH_VERBOSE=1 prints a line per active-set round, BENCH_NEWTON_VERBOSE=1 a line per Newton iteration.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -46,6 +47,7 @@ int main(int argc, char** argv) {
     opt.active_set.verbose = std::getenv("BENCH_VERBOSE") != nullptr;  // a line per active-set round on stderr
     opt.solver_options.tol = 1e-8;
     opt.solver_options.max_iter = max_iter;
+    opt.solver_options.verbose = std::getenv("BENCH_NEWTON_VERBOSE") != nullptr;  // a line per Newton iteration
     const WetRun r = run_wet(net, m, Eigen::Matrix2d::Identity(), opt);
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf(

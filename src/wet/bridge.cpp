@@ -169,6 +169,26 @@ bool bridge_weights(const BridgeElement& e, T g[2][4], T w[2][3], T& lambda) {
             if (value_of(lambda) != 1) w[s][0] = lambda * w[s][0], w[s][2] = lambda * w[s][2];
         }
         w[s][1] = 1.0 - w[s][0] - w[s][2];
+        // Window fades: a neighbour's term fades out (C2) as the crossing passes the neighbour's far node, over a
+        // quarter of its length, and the home's weight does not take that share. A crossing never gets there while
+        // the set is kept consistent (it moves a bridge 0.1 blend half-widths past a node), but in a long solve of a
+        // fixed set it can: the neighbour's term then kept full weight however far the crossing ran, a bridge between
+        // segments that no longer cross (seen 5 fiber lengths away on a 100-fiber benchmark network).
+        if (value_of(lambda) != 0) {
+            const double* l0 = e.l0 + 3 * s;
+            if (e.node[4 * s] >= 0 && value_of(w[s][0]) != 0) {  // beyond node k-1: z0 < -l0[0]
+                const double df = 0.125 * l0[0], c = l0[0] + df;
+                const double x = (value_of(z[s][0]) + c) / df;
+                if (x <= -1) w[s][0] = T(0.0);
+                else if (x < 1) w[s][0] = w[s][0] * smoothstep((z[s][0] + c) / df), varies = true;
+            }
+            if (e.node[4 * s + 3] >= 0 && value_of(w[s][2]) != 0) {  // beyond node k+2: z1 > l0[2]
+                const double df = 0.125 * l0[2], c = l0[2] + df;
+                const double x = (value_of(z[s][1]) - c) / df;
+                if (x >= 1) w[s][2] = T(0.0);
+                else if (x > -1) w[s][2] = w[s][2] * (1.0 - smoothstep((z[s][1] - c) / df)), varies = true;
+            }
+        }
     }
     if (value_of(lambda) == 0) varies = false;
     return varies;

@@ -14,7 +14,7 @@ using namespace fibernet;
 
 namespace {
 
-enum class Kind { Blend, Fade, Mid, Locked };
+enum class Kind { Blend, Fade, Mid, Locked, Far };
 
 // Side 0 along x (home segment from (0, 0) to (l, 0)), side 1 crossing it at angle alpha; both bent a little, rest
 // lengths a little off the actual ones, the whole element moved and turned at random.
@@ -27,8 +27,14 @@ Vector16d random_element(Rng& rng, Kind kind, BridgeElement& e) {
     for (auto& s : len)
         for (double& l : s) l = rng.uniform(0.05, 0.15);
     // Where each side's crossing is, as the fraction of its home: near a node (blend zone |z| < l / 4), or mid.
+    const int far_side = rng.bernoulli(0.5) ? 1 : 0;
+    const bool far_plus = rng.bernoulli(0.5);
     auto place = [&](int s) {
-        if (kind == Kind::Mid || kind == Kind::Locked) return rng.uniform(0.35, 0.65);
+        if (kind == Kind::Mid || kind == Kind::Locked || (kind == Kind::Far && s != far_side)) return rng.uniform(0.35, 0.65);
+        if (kind == Kind::Far) {  // past a neighbour's far node, inside the window fade (a quarter of the neighbour)
+            const double u = rng.uniform(0.05, 0.95) * 0.25;
+            return far_plus ? 1 + len[s][2] * (1 + u) / len[s][1] : -len[s][0] * (1 + u) / len[s][1];
+        }
         if (rng.bernoulli(0.15)) return rng.uniform(0.3, 0.7);  // this side off its zones
         return (rng.bernoulli(0.5) ? 0.0 : 1.0) + rng.uniform(-0.3, 0.3) * std::min(len[s][0], len[s][2]) / len[s][1];
     };
@@ -51,7 +57,7 @@ Vector16d random_element(Rng& rng, Kind kind, BridgeElement& e) {
     // Fiber ends: a missing neighbour (its coordinates zero, its segment's l0 zero, as resolve() makes them).
     for (int s = 0; s < 2; ++s)
         for (int end : {0, 3})
-            if (rng.bernoulli(0.2)) {
+            if (rng.bernoulli(kind == Kind::Far ? 0.05 : 0.2)) {
                 e.node[4 * s + end] = -1, e.l0[3 * s + (end == 0 ? 0 : 2)] = 0;
                 X.segment<2>(2 * (4 * s + end)).setZero();
             }
@@ -65,7 +71,7 @@ TEST_CASE("bridge element: chain rule through the signed distances equals the Je
     CapillaryLaw law;
     const double beta = 1.7;
     int n_zone = 0, n_fade = 0, n_end = 0;
-    for (Kind kind : {Kind::Blend, Kind::Fade, Kind::Mid, Kind::Locked})
+    for (Kind kind : {Kind::Blend, Kind::Fade, Kind::Mid, Kind::Locked, Kind::Far})
         for (int n = 0; n < 400; ++n) {
             BridgeElement e;
             const Vector16d X = random_element(rng, kind, e);
@@ -88,10 +94,12 @@ TEST_CASE("bridge element: chain rule through the signed distances equals the Je
                 const double E1 = bridge_element_energy(e, X, beta, law, &g1, &H1, psd);
                 const double Eg = bridge_element_energy(e, X, beta, law, &gg, nullptr, psd);
                 INFO("kind " << static_cast<int>(kind) << ", element " << n << ", psd " << psd);
-                CHECK(std::abs(E1 - E0) <= 1e-12 * std::abs(E0));  // seen: 1.3e-13
+                // Relative to |E0|, or to the element's scale beta l where a fade takes E0 to 0.
+                const double es = std::abs(E0) + 1e-3 * beta * e.l0[1];
+                CHECK(std::abs(E1 - E0) <= 1e-12 * es);  // seen: 1.3e-13
                 CHECK(Eg == E1);
                 // The value alone goes through law_ rather than bridge_energy: the same to round-off.
-                CHECK(std::abs(bridge_element_energy(e, X, beta, law, nullptr, nullptr) - E0) <= 1e-12 * std::abs(E0));
+                CHECK(std::abs(bridge_element_energy(e, X, beta, law, nullptr, nullptr) - E0) <= 1e-12 * es);
                 const double gs = g0.cwiseAbs().maxCoeff(), hs = H0.cwiseAbs().maxCoeff();
                 CHECK((g1 - g0).cwiseAbs().maxCoeff() <= 1e-11 * gs);  // seen: 5e-13
                 CHECK((gg - g1).cwiseAbs().maxCoeff() == 0);
@@ -104,13 +112,13 @@ TEST_CASE("bridge element: chain rule through the signed distances equals the Je
     CHECK(n_end > 300);
 }
 
-TEST_CASE("bridge element: derivatives match finite differences while lambda fades", "[wet][bridge][gradient]") {
-    // The network tests rarely reach the near-parallel fade; check it here directly.
+TEST_CASE("bridge element: derivatives match finite differences while lambda or the window fades", "[wet][bridge][gradient]") {
+    // The network tests rarely reach the near-parallel fade or the window's end; check them here directly.
     Rng rng(7);
     CapillaryLaw law;
-    for (int n = 0; n < 40; ++n) {
+    for (int n = 0; n < 80; ++n) {
         BridgeElement e;
-        const Vector16d X0 = random_element(rng, Kind::Fade, e);
+        const Vector16d X0 = random_element(rng, n < 40 ? Kind::Fade : Kind::Far, e);
         const Eigen::VectorXd X = X0;
         auto val = [&](const Eigen::VectorXd& v) {
             return bridge_element_energy(e, Vector16d(v), 1.0, law, nullptr, nullptr);
@@ -129,4 +137,31 @@ TEST_CASE("bridge element: derivatives match finite differences while lambda fad
         CHECK((Eigen::VectorXd(g) - fg).cwiseAbs().maxCoeff() <= 1e-6 * std::max(1.0, g.cwiseAbs().maxCoeff()));
         CHECK((Eigen::MatrixXd(H) - fh).cwiseAbs().maxCoeff() <= 1e-5 * std::max(1.0, H.cwiseAbs().maxCoeff()));
     }
+}
+
+TEST_CASE("bridge element: a crossing that left the window of home +- 1 segment pulls no more", "[wet][bridge]") {
+    // Side 0 along x, segments of 0.1 (home from 0 to 0.1); side 1 at 60 deg through (x, 0). A stale set (a long solve
+    // of a fixed set) can carry a crossing past the + neighbour's far node at x = 0.2: the neighbour's term fades out
+    // over a quarter of its length beyond it, and the home takes no share.
+    CapillaryLaw law;
+    BridgeElement e;
+    for (int a = 0; a < 8; ++a) e.node[a] = a, e.shift[a] = {0, 0};
+    for (double& l : e.l0) l = 0.1;
+    const Eigen::Vector2d u(std::cos(M_PI / 3), std::sin(M_PI / 3));
+    auto at = [&](double x) {
+        Vector16d X;
+        for (int a = 0; a < 4; ++a) X.segment<2>(2 * a) = Eigen::Vector2d(0.1 * (a - 1), 0);
+        for (int a = 0; a < 4; ++a) X.segment<2>(8 + 2 * a) = Eigen::Vector2d(x, 0) + 0.1 * (a - 1.5) * u;
+        return X;
+    };
+    Vector16d g;
+    const double full = bridge_element_energy(e, at(0.15), 1.0, law, &g, nullptr);  // inside the + neighbour
+    CHECK(full == Approx(-0.1 * 0.25));                                             // -beta l cos^2 60
+    const double zone = bridge_element_energy(e, at(0.2 + 0.0125), 1.0, law, &g, nullptr);  // mid-fade
+    CHECK(zone == Approx(0.5 * full));
+    const double out = bridge_element_energy(e, at(0.2 + 0.03), 1.0, law, &g, nullptr);  // past the fade
+    CHECK(out == 0);
+    CHECK(g.cwiseAbs().maxCoeff() == 0);
+    CHECK(bridge_element_energy(e, at(-0.1 - 0.03), 1.0, law, &g, nullptr) == 0);  // the same on the - side
+    CHECK(bridge_element_energy(e, at(-0.1 - 0.0125), 1.0, law, &g, nullptr) == Approx(0.5 * full));
 }

@@ -23,7 +23,7 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
     const Scene r = parse_scene("[wet]\nmax_rounds = 50\nround_iterations = 0\n", "r.toml");
     CHECK(r.wet.max_rounds == 50);
     CHECK(r.wet.round_iterations == 0);
-    CHECK(parse_scene("", "empty.toml").wet.round_iterations == 0);
+    CHECK(parse_scene("", "empty.toml").wet.round_iterations == 10);
     struct Bad {
         std::string toml, needle;
     };

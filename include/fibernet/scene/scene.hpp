@@ -30,7 +30,7 @@ struct WetSettings {
     std::string free_box_shape = "isotropic";  // isotropic (F = s F0) | full (symmetric U, 3 unknowns)
     double free_box_tol = 1e-3;           // |sigma| / sigma_c below which the free box has converged, > 0
     int max_rounds = 200;       // active-set rounds (bridge-set updates) per relaxation, >= 1
-    int round_iterations = 0;   // Newton iterations per round while the set changes (0: solve each round to the end)
+    int round_iterations = 10;  // Newton iterations per round while the set changes (0: solve each round to the end)
 };
 
 struct Scene {

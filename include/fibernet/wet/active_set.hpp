@@ -42,12 +42,12 @@ struct WetEvents {
 struct ActiveSetOptions {
     int max_rounds = 200;
     // > 0: while the set keeps changing, a round's solve stops after this many solver iterations and the set is
-    // updated (events interleaved with the solve); a round that leaves the set unchanged lifts the cap for the next.
-    // 0 (default): every round is solved to convergence. Cutting rounds at 10 Newton iterations takes 4-5x fewer
-    // iterations but ends in shallower minima (mean energy about 2/3, 20 % fewer bridges over 16 networks of 100
-    // fibers; docs/wet.md, "Rounds"), so it is an option, not the default. run_wet ignores it for first-order solvers,
-    // whose iterations are cheap and many.
-    int round_iterations = 0;
+    // updated (events interleaved with the solve: new crossings get their bridges while the fibers still move); a
+    // round that leaves the set unchanged, or returns to an earlier set, lifts the cap for the next. 0: every round is
+    // solved to convergence, so a fiber sweeps across others without feeling them until the solve ends, which ends
+    // in deeper minima with more bridges (over 16 networks of 100 fibers: K = 3..20 agree, K = 0 does not; docs/wet.md,
+    // "Rounds") and takes 2x the Newton iterations. run_wet ignores it for first-order solvers (cheap, many iterations).
+    int round_iterations = 10;
     bool warm_start = true;       // a round after a cut one resumes the solver's adapted state (SolverOptions::warm_start)
     bool form_new = true;        // give new crossings and new contacts bridges
     double contact_distance = 0;  // seed units; 0: the fiber diameter 2 r = 2 ls / a

@@ -16,6 +16,10 @@
 // w_0 = 1 - w_- - w_+. At a node the weights are 1/2 and 1/2, and the element of home a and that of home a- are the
 // same function near their shared node, so moving the bridge changes no energy. A missing neighbour (fiber end) has
 // a zero term: the bridge fades out as its crossing slides off the end, and ruptures once its weight is zero.
+// The window ends the same way: a neighbour's weight fades out (C2, S((z + l0 + df) / df) with df = l0 / 8 on the
+// - side, mirrored on the + side) as the crossing passes the neighbour's far node, over a quarter of its length, so a
+// bridge whose crossing left its 3 x 3 window during a solve of a fixed set pulls no more (it used to keep the
+// neighbour's full term however far away the crossing ran). A consistent set never reaches that zone.
 // Nearly parallel pairs have no well-defined crossing (r -> 0 sends it to infinity): as any |r| (~ sin alpha) falls from
 // sin 5 deg to sin 2 deg, the blend fades (C2) into home-only weights (w_0 = 1), and such a bridge does not move.
 //
