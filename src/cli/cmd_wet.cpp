@@ -6,6 +6,7 @@
 // reported, marked).
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 
 #include "common.hpp"
@@ -123,7 +124,8 @@ void register_wet(CLI::App& app) {
     auto* o_cr = cmd->add_option("--crossings", w->crossings, "wet crossings: all | free | fraction (default all)");
     auto* o_fr = cmd->add_option("--fraction", w->fraction, "wet fraction of crossings, in [0, 1]");
     auto* o_ws = cmd->add_option("--wet-seed", w->seed, "seed of the wet fraction draw");
-    cmd->add_option("-o,--out-dir", w->out, "write summary.json, sweep.csv, pores.csv, network.svg, pores.svg here");
+    cmd->add_option("-o,--out-dir", w->out,
+                    "write summary.json, sweep.csv, pores.csv, network.svg, pores.svg here (created if missing)");
     cmd->add_flag("--no-moduli", w->no_moduli, "skip the dry and wet shear moduli");
     auto* o_fb = cmd->add_flag("--free-box", w->free_box,
                                "then find the zero-stress box of the wet network (drying shrinkage, docs/wet.md)");
@@ -179,6 +181,13 @@ void register_wet(CLI::App& app) {
         const Model m = discretize(net, s.discretization);
         const Eigen::Matrix2d F = deformation(s.strain, s.gamma);
         const Eigen::Matrix2d B = F * m.box.B0();
+        if (!w->out.empty()) {  // made (like mkdir -p) before any work, so a bad path costs no relaxation
+            std::error_code ec;
+            std::filesystem::create_directories(w->out, ec);
+            if (ec || !std::filesystem::is_directory(w->out))
+                throw InputError("--out-dir '" + w->out + "': cannot create the directory" +
+                                 (ec ? " (" + ec.message() + ")" : std::string(" (a file of that name exists)")));
+        }
 
         nlohmann::json runs = nlohmann::json::array();
         std::ostringstream sweep, pore_csv;

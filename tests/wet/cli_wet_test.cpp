@@ -17,8 +17,8 @@ int run(const std::string& args) { return clitest::run("wet " + args); }
 }  // namespace
 
 TEST_CASE("cli wet: a small run writes its documented outputs", "[wet][cli]") {
-    const std::string out = tmpdir() + "/ok";
-    REQUIRE(std::system(("mkdir -p " + out).c_str()) == 0);
+    const std::string out = tmpdir() + "/ok/new/dir";  // -o makes missing directories
+    REQUIRE(std::system(("rm -rf " + tmpdir() + "/ok").c_str()) == 0);
     // beta = 0: the wet state is the dry one, so the run is quick and stable.
     REQUIRE(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0 --no-moduli -o " + out) == 0);
     for (const char* f : {"summary.json", "sweep.csv", "pores.csv", "network.svg", "pores.svg"}) CHECK(exists(out + "/" + f));
@@ -62,6 +62,9 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
         CHECK(slurp(tmpdir() + "/stderr").find(c.needle) != std::string::npos);
         CHECK(!exists(out + "/summary.json"));
     }
+    // An output directory that cannot be made (a file is in the way) is refused before any work.
+    CHECK(run("--L 2.5 --q 5 --beta 0 -o " + law + "/sub") == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("cannot create the directory") != std::string::npos);
 }
 
 TEST_CASE("cli wet: --free-box reports the zero-stress box, and exit 1 when it is not found", "[wet][cli][free_box]") {
