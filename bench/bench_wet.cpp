@@ -1,7 +1,7 @@
 // Wet relaxation benchmark (issue 6, "Performance"): a Mikado network of N fibers (density q, pl = 0.5, seed
 // scheme) relaxed dry, wetted at all crossings and relaxed under capillary load with mobile bridges.
 // Prints one JSON line per run with the time split: dry Newton, wet Newton, event handling, pore analysis.
-//   bench_wet [N=1000] [q=10] [beta=0.01] [max_rounds=200] [newton_max_iter=500] [scheme=seed] [seed=1] [move_margin=0.1]
+//   bench_wet [N=1000] [q=10] [beta=0.01] [max_rounds=1000] [newton_max_iter=500] [scheme=seed] [seed=1] [move_margin=0.1]
 //             [round_iterations=10] [warm_start=1]
 // The "newton" block sums the wet solves' time split over all rounds.
 // Environment: BENCH_VERBOSE=1 prints a line per active-set round, BENCH_NEWTON_VERBOSE=1 a line per Newton iteration.

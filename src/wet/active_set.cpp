@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <iterator>
 #include <map>
@@ -179,7 +180,8 @@ std::vector<Bridge> segment_contacts(const Model& m, const Eigen::VectorXd& x, c
 }
 
 WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
-                         std::vector<Bridge>& bridges, const ActiveSetOptions& opt, const FiberPairs* frozen) {
+                         std::vector<Bridge>& bridges, const ActiveSetOptions& opt, const FiberPairs* frozen,
+                         bool settled) {
     auto is_frozen = [&](int f1, int f2) { return frozen && frozen->count({std::min(f1, f2), std::max(f1, f2)}); };
     const Model& m = dry.model();
     const Eigen::VectorXd x = dry.positions(q, F);
@@ -246,7 +248,9 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
                                                cp.z[1][0] >= cp.delta[1][0] && cp.z[1][1] <= -cp.delta[1][1]);
         if (home_only && c.sin_angle <= sin_c && c.distance <= rc && c.overlap > 0) {
             b.locked = true, ++ev.locked;
-        } else if (!cp.defined && (c.distance > 2 * rc || c.overlap == 0)) {
+        } else if (settled && !cp.defined && (c.distance > 2 * rc || c.overlap == 0)) {
+            // Only at an equilibrium: mid-solve (a cut round) two fibers being pulled parallel are often not yet in
+            // contact, and rupturing them there made them cross, re-form and rupture again for hundreds of rounds.
             ++ev.ruptures;
             continue;
         }
@@ -311,7 +315,24 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         std::sort(v.begin(), v.end());
         return v;
     };
-    std::vector<std::vector<std::array<int, 7>>> history{signature(bridges)};  // the set after each round (0: start)
+    // The set after each round (0: start), as a hash, and in full for the last kKeep rounds only: with short rounds a
+    // large network runs hundreds of rounds of ~1e4-1e5 bridges each. Repeats are found by hash (64 bits); a cycle
+    // can only be named (and broken) if both sets involved are still kept, which covers cycles of up to kKeep rounds.
+    using Signature = std::vector<std::array<int, 7>>;
+    constexpr size_t kKeep = 16;
+    auto hash_of = [](const Signature& sg) {
+        std::uint64_t h = 1469598103934665603ull;  // FNV-1a
+        for (const auto& a : sg)
+            for (int v : a) h = (h ^ static_cast<std::uint32_t>(v)) * 1099511628211ull;
+        return h;
+    };
+    std::vector<Signature> history{signature(bridges)};
+    std::vector<std::uint64_t> hashes{hash_of(history[0])};
+    auto remember = [&](Signature sg) {
+        hashes.push_back(hash_of(sg));
+        history.push_back(std::move(sg));
+        if (history.size() > kKeep) Signature().swap(history[history.size() - kKeep - 1]);
+    };
     FiberPairs frozen;
     // The solver's options, restored on return; rounds are capped below its budget while the set keeps changing.
     SolverOptions& so = solver.options();
@@ -347,7 +368,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             break;
         }
         t0 = now();
-        const WetEvents ev = update_bridges(dry, q, F, bridges, opt, &frozen);
+        const WetEvents ev = update_bridges(dry, q, F, bridges, opt, &frozen, r.last.converged());
         r.per_round.push_back(ev);
         r.events.moves += ev.moves, r.events.ruptures += ev.ruptures;
         r.events.formed += ev.formed, r.events.merged += ev.merged, r.events.locked += ev.locked;
@@ -379,13 +400,15 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         // The next round is capped only if this one changed the set to one not seen before: once it has settled, or
         // toggles (a bridge moving back and forth while the rest still moves), the solve finishes, and a repeat
         // after a finished solve is a cycle (below). Without this a 3000-fiber run toggled 3 bridges for 250 rounds.
-        capped = cap && std::find(history.begin(), history.end(), sig) == history.end();
-        const auto again = std::find(history.begin(), history.end(), sig);
-        if (!limit && again != history.end()) {
+        const std::uint64_t hs = hash_of(sig);
+        const auto again_h = std::find(hashes.begin(), hashes.end(), hs);
+        capped = cap && again_h == hashes.end();
+        if (!limit && again_h != hashes.end()) {
+            const auto again = history.begin() + (again_h - hashes.begin());
             // Name what toggles: the bridges in which the sets after the repeated round and after the next differ.
             const size_t j = static_cast<size_t>(again - history.begin());
             std::vector<std::array<int, 7>> diff;  // empty if the set did not change at all (a solver that wanders)
-            if (j + 1 < history.size())
+            if (j + 1 < history.size() && !history[j].empty() && !history[j + 1].empty())
                 std::set_symmetric_difference(history[j].begin(), history[j].end(), history[j + 1].begin(),
                                               history[j + 1].end(), std::back_inserter(diff));
             std::string which;
@@ -406,13 +429,14 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
                 r.frozen_pairs = static_cast<int>(frozen.size());
                 if (opt.verbose) std::fprintf(stderr, "wet round %2d: cycling (%s): fiber pairs frozen\n", round, what.c_str());
                 history.assign(1, sig);
+                hashes.assign(1, hs);
                 continue;
             }
             r.cycling = true;
             r.message = "cycling: " + what;
             break;
         }
-        history.push_back(sig);
+        remember(sig);
     }
     if (!r.stable && !r.cycling && r.message.empty())  // every round used, the last one possibly breaking a cycle
         r.message = "no stable bridge set after " + std::to_string(r.rounds) + " rounds (last solve: " +

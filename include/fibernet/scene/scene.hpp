@@ -29,7 +29,7 @@ struct WetSettings {
     bool free_box = false;      // after the fixed-box relaxation, find the zero-stress box (docs/wet.md, "Free box")
     std::string free_box_shape = "isotropic";  // isotropic (F = s F0) | full (symmetric U, 3 unknowns)
     double free_box_tol = 1e-3;           // |sigma| / sigma_c below which the free box has converged, > 0
-    int max_rounds = 200;       // active-set rounds (bridge-set updates) per relaxation, >= 1
+    int max_rounds = 1000;      // active-set rounds (bridge-set updates) per relaxation, >= 1
     int round_iterations = 10;  // Newton iterations per round while the set changes (0: solve each round to the end)
 };
 

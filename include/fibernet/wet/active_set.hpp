@@ -40,7 +40,7 @@ struct WetEvents {
 };
 
 struct ActiveSetOptions {
-    int max_rounds = 200;
+    int max_rounds = 1000;      // a cut round is only round_iterations solver iterations
     // > 0: while the set keeps changing, a round's solve stops after this many solver iterations and the set is
     // updated (events interleaved with the solve: new crossings get their bridges while the fibers still move); a
     // round that leaves the set unchanged, or returns to an earlier set, lifts the cap for the next. 0: every round is
@@ -76,10 +76,11 @@ struct ActiveSetResult {
 using FiberPairs = std::set<std::pair<int, int>>;
 
 // Updates `bridges` (moves, ruptures, merges; new bridges if form_new) at state q of `dry` at F; returns the counts.
-// Bridges between `frozen` fiber pairs are kept unchanged and such pairs get no new bridges.
+// Bridges between `frozen` fiber pairs are kept unchanged and such pairs get no new bridges. settled: q is an
+// equilibrium of the current set; only then does a nearly parallel (unlocked) pair out of contact rupture.
 WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
                          std::vector<Bridge>& bridges, const ActiveSetOptions& opt = {},
-                         const FiberPairs* frozen = nullptr);
+                         const FiberPairs* frozen = nullptr, bool settled = true);
 
 // All intersecting segment pairs of different fibers that share no node, as bridges (nearest periodic image).
 std::vector<Bridge> segment_crossings(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B);
