@@ -316,8 +316,8 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         return v;
     };
     // The set after each round (0: start), as a hash, and in full for the last kKeep rounds only: with short rounds a
-    // large network runs hundreds of rounds of ~1e4-1e5 bridges each. Repeats are found by hash (64 bits); a cycle
-    // can only be named (and broken) if both sets involved are still kept, which covers cycles of up to kKeep rounds.
+    // large network runs hundreds of rounds of ~1e4-1e5 bridges each. Repeats are found by hash (64 bits); the
+    // toggling bridges are named from this round's change (the previous set is always kept).
     using Signature = std::vector<std::array<int, 7>>;
     constexpr size_t kKeep = 16;
     auto hash_of = [](const Signature& sg) {
@@ -328,11 +328,14 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
     };
     std::vector<Signature> history{signature(bridges)};
     std::vector<std::uint64_t> hashes{hash_of(history[0])};
-    auto remember = [&](Signature sg) {
+    std::vector<int> round_of{0};  // the round after which each entry was recorded
+    auto remember = [&](Signature sg, int round) {
         hashes.push_back(hash_of(sg));
         history.push_back(std::move(sg));
+        round_of.push_back(round);
         if (history.size() > kKeep) Signature().swap(history[history.size() - kKeep - 1]);
     };
+    auto kept = [&](size_t i) { return i + kKeep >= history.size(); };
     FiberPairs frozen;
     // The solver's options, restored on return; rounds are capped below its budget while the set keeps changing.
     SolverOptions& so = solver.options();
@@ -401,22 +404,25 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         // toggles (a bridge moving back and forth while the rest still moves), the solve finishes, and a repeat
         // after a finished solve is a cycle (below). Without this a 3000-fiber run toggled 3 bridges for 250 rounds.
         const std::uint64_t hs = hash_of(sig);
-        const auto again_h = std::find(hashes.begin(), hashes.end(), hs);
-        capped = cap && again_h == hashes.end();
-        if (!limit && again_h != hashes.end()) {
-            const auto again = history.begin() + (again_h - hashes.begin());
-            // Name what toggles: the bridges in which the sets after the repeated round and after the next differ.
-            const size_t j = static_cast<size_t>(again - history.begin());
+        const auto again_h = std::find(hashes.rbegin(), hashes.rend(), hs);  // the most recent occurrence
+        capped = cap && again_h == hashes.rend();
+        if (!limit && again_h != hashes.rend()) {
+            const size_t j = static_cast<size_t>(hashes.rend() - again_h) - 1;
+            // Name what toggles: the bridges this round changed (it came back to the set after round j); if it changed
+            // nothing, those in which the set after round j and the next different kept one differ.
             std::vector<std::array<int, 7>> diff;  // empty if the set did not change at all (a solver that wanders)
-            if (j + 1 < history.size() && !history[j].empty() && !history[j + 1].empty())
-                std::set_symmetric_difference(history[j].begin(), history[j].end(), history[j + 1].begin(),
-                                              history[j + 1].end(), std::back_inserter(diff));
+            std::set_symmetric_difference(history.back().begin(), history.back().end(), sig.begin(), sig.end(),
+                                          std::back_inserter(diff));
+            for (size_t k = j + 1; diff.empty() && kept(j) && k < history.size(); ++k)
+                std::set_symmetric_difference(history[j].begin(), history[j].end(), history[k].begin(),
+                                              history[k].end(), std::back_inserter(diff));
             std::string which;
             for (size_t k = 0; k < diff.size() && k < 4; ++k)
                 which += (k ? ", " : "") + std::string("fibers ") + std::to_string(diff[k][0]) + "/" + std::to_string(diff[k][1]) +
                          " segments " + std::to_string(diff[k][2]) + "/" + std::to_string(diff[k][3]);
             const std::string what = "the bridge set after round " + std::to_string(round) + " repeats " +
-                                     (j == 0 ? std::string("the initial one") : "that after round " + std::to_string(j)) +
+                                     (round_of[j] == 0 ? std::string("the initial one")
+                                                       : "that after round " + std::to_string(round_of[j])) +
                                      "; " + std::to_string(diff.size()) + " bridge entries toggle (" + which +
                                      (diff.size() > 4 ? ", ..." : "") + ")";
             // Break the cycle: the fiber pairs of the toggling bridges keep their current bridges from here on (no
@@ -430,13 +436,14 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
                 if (opt.verbose) std::fprintf(stderr, "wet round %2d: cycling (%s): fiber pairs frozen\n", round, what.c_str());
                 history.assign(1, sig);
                 hashes.assign(1, hs);
+                round_of.assign(1, round);
                 continue;
             }
             r.cycling = true;
             r.message = "cycling: " + what;
             break;
         }
-        remember(sig);
+        remember(sig, round);
     }
     if (!r.stable && !r.cycling && r.message.empty())  // every round used, the last one possibly breaking a cycle
         r.message = "no stable bridge set after " + std::to_string(r.rounds) + " rounds (last solve: " +
