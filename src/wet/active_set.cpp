@@ -329,8 +329,8 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
     std::vector<Signature> history{signature(bridges)};
     std::vector<std::uint64_t> hashes{hash_of(history[0])};
     std::vector<int> round_of{0};  // the round after which each entry was recorded
-    auto remember = [&](Signature sg, int round) {
-        hashes.push_back(hash_of(sg));
+    auto remember = [&](Signature sg, std::uint64_t h, int round) {
+        hashes.push_back(h);
         history.push_back(std::move(sg));
         round_of.push_back(round);
         if (history.size() > kKeep) Signature().swap(history[history.size() - kKeep - 1]);
@@ -359,9 +359,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         r.seconds_solve += now() - t0;
         r.solver_iterations += r.last.iterations;
         r.factorizations += r.last.factorizations;
-        r.timings.assembly += r.last.timings.assembly, r.timings.factorization += r.last.timings.factorization;
-        r.timings.solve += r.last.timings.solve, r.timings.line_search += r.last.timings.line_search;
-        r.timings.total += r.last.timings.total;
+        r.timings += r.last.timings;
         // An iteration limit is not final: large motions (a fiber zipping onto another) make the set stale long before
         // the solve ends, so the set is updated and the solve continues with it. Other failures end the loop.
         const bool limit = r.last.status == SolveStatus::IterationLimit;
@@ -399,7 +397,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
                                         : std::string());
             break;
         }
-        const auto sig = signature(bridges);
+        auto sig = signature(bridges);
         // The next round is capped only if this one changed the set to one not seen before: once it has settled, or
         // toggles (a bridge moving back and forth while the rest still moves), the solve finishes, and a repeat
         // after a finished solve is a cycle (below). Without this a 3000-fiber run toggled 3 bridges for 250 rounds.
@@ -443,7 +441,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             r.message = "cycling: " + what;
             break;
         }
-        remember(sig, round);
+        remember(std::move(sig), hs, round);
     }
     if (!r.stable && !r.cycling && r.message.empty())  // every round used, the last one possibly breaking a cycle
         r.message = "no stable bridge set after " + std::to_string(r.rounds) + " rounds (last solve: " +

@@ -198,77 +198,9 @@ TEST_CASE("active set: zipped fibers hold one bridge per segment pair, adhesion 
 }
 
 namespace {
-// A stand-in solver that alternates between two given states (and reports convergence): the bridge set it leaves
-// behind alternates too, which the loop must report as cycling instead of running to max_rounds.
-class Alternating : public Solver {
-public:
-    Alternating(Eigen::VectorXd a, Eigen::VectorXd b) : s_{std::move(a), std::move(b)} {}
-    std::string name() const override { return "alternating"; }
-    SolverOptions& options() override { return opt_; }
-    SolveResult minimize(Objective&, Eigen::VectorXd& q) override {
-        q = s_[k_++ % 2];
-        SolveResult r;
-        r.status = SolveStatus::Converged;
-        r.grad_max = 0;
-        return r;
-    }
-
-private:
-    Eigen::VectorXd s_[2];
-    int k_ = 0;
-    SolverOptions opt_;
-};
-}  // namespace
-
-TEST_CASE("active set: a bridge set that repeats is reported as cycling", "[wet][events]") {
-    const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.45, 1.5, 60, 1, 0.45}}, 3);
-    const Model m = model_of(net);
-    NetworkEnergy e(m);
-    const Eigen::VectorXd q0 = e.dofs(m.x);
-    Alternating solver(moved(e, q0, 1, -2, 0), moved(e, q0, 1, -1, 0));  // crossing at x = 12.5, then 13.5
-    WetParams p;
-    p.beta = 1;
-    Eigen::VectorXd q = q0;
-    ActiveSetOptions opt;
-    opt.form_new = false;
-    opt.max_freezes = 0;  // report the first repeat
-    const ActiveSetResult r = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver, q, opt);
-    CHECK(r.cycling);
-    CHECK(!r.stable);
-    CHECK(r.rounds == 3);
-    CHECK(r.message.find("cycling") != std::string::npos);
-    CHECK(r.message.find("fibers 0/1") != std::string::npos);  // names the toggling bridge
-    CHECK(r.events.moves >= 3);
-    CHECK(r.cycles_broken == 0);
-
-    // By default the repeat is broken by freezing the pair's bridge; this stand-in solver still never reaches an
-    // equilibrium (it alternates whatever the energy), so the loop ends cycling after the frozen round repeats.
-    Alternating solver2(moved(e, q0, 1, -2, 0), moved(e, q0, 1, -1, 0));
-    Eigen::VectorXd q2 = q0;
-    ActiveSetOptions opt2;
-    opt2.form_new = false;
-    const ActiveSetResult r2 = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver2, q2, opt2);
-    CHECK(r2.cycles_broken == 1);
-    CHECK(r2.frozen_pairs == 1);
-    CHECK(r2.cycling);
-    CHECK(!r2.stable);
-    CHECK(r2.rounds < opt2.max_rounds);
-
-    // A cycle broken in the last allowed round still ends with a message saying the rounds ran out.
-    Alternating solver3(moved(e, q0, 1, -2, 0), moved(e, q0, 1, -1, 0));
-    Eigen::VectorXd q3 = q0;
-    ActiveSetOptions opt3;
-    opt3.form_new = false;
-    opt3.max_rounds = 3;  // the repeat is found (and broken) in round 3
-    const ActiveSetResult r3 = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver3, q3, opt3);
-    CHECK(r3.cycles_broken == 1);
-    CHECK(!r3.stable);
-    CHECK(r3.message == "no stable bridge set after 3 rounds (last solve: converged)");
-}
-
-namespace {
 // A stand-in solver that plays a script of states and statuses (IterationLimit: a cut round), then alternates
-// between the last two states, reporting convergence.
+// between the last two states, reporting convergence. With two states and no statuses it alternates from the start,
+// so the bridge set it leaves behind alternates too, which the loop must report as cycling.
 class Scripted : public Solver {
 public:
     Scripted(std::vector<Eigen::VectorXd> q, std::vector<SolveStatus> st) : q_(std::move(q)), st_(std::move(st)) {}
@@ -291,6 +223,52 @@ private:
     SolverOptions opt_;
 };
 }  // namespace
+
+TEST_CASE("active set: a bridge set that repeats is reported as cycling", "[wet][events]") {
+    const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.45, 1.5, 60, 1, 0.45}}, 3);
+    const Model m = model_of(net);
+    NetworkEnergy e(m);
+    const Eigen::VectorXd q0 = e.dofs(m.x);
+    Scripted solver({moved(e, q0, 1, -2, 0), moved(e, q0, 1, -1, 0)}, {});  // crossing at x = 12.5, then 13.5
+    WetParams p;
+    p.beta = 1;
+    Eigen::VectorXd q = q0;
+    ActiveSetOptions opt;
+    opt.form_new = false;
+    opt.max_freezes = 0;  // report the first repeat
+    const ActiveSetResult r = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver, q, opt);
+    CHECK(r.cycling);
+    CHECK(!r.stable);
+    CHECK(r.rounds == 3);
+    CHECK(r.message.find("cycling") != std::string::npos);
+    CHECK(r.message.find("fibers 0/1") != std::string::npos);  // names the toggling bridge
+    CHECK(r.events.moves >= 3);
+    CHECK(r.cycles_broken == 0);
+
+    // By default the repeat is broken by freezing the pair's bridge; this stand-in solver still never reaches an
+    // equilibrium (it alternates whatever the energy), so the loop ends cycling after the frozen round repeats.
+    Scripted solver2({moved(e, q0, 1, -2, 0), moved(e, q0, 1, -1, 0)}, {});
+    Eigen::VectorXd q2 = q0;
+    ActiveSetOptions opt2;
+    opt2.form_new = false;
+    const ActiveSetResult r2 = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver2, q2, opt2);
+    CHECK(r2.cycles_broken == 1);
+    CHECK(r2.frozen_pairs == 1);
+    CHECK(r2.cycling);
+    CHECK(!r2.stable);
+    CHECK(r2.rounds < opt2.max_rounds);
+
+    // A cycle broken in the last allowed round still ends with a message saying the rounds ran out.
+    Scripted solver3({moved(e, q0, 1, -2, 0), moved(e, q0, 1, -1, 0)}, {});
+    Eigen::VectorXd q3 = q0;
+    ActiveSetOptions opt3;
+    opt3.form_new = false;
+    opt3.max_rounds = 3;  // the repeat is found (and broken) in round 3
+    const ActiveSetResult r3 = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver3, q3, opt3);
+    CHECK(r3.cycles_broken == 1);
+    CHECK(!r3.stable);
+    CHECK(r3.message == "no stable bridge set after 3 rounds (last solve: converged)");
+}
 
 TEST_CASE("active set: a cycle after cut rounds that changed nothing is named and broken", "[wet][events]") {
     // A, A (two cut rounds, the second leaving the set as it was), B, A (finished): the set after the last round

@@ -17,6 +17,11 @@ std::string to_string(SolveStatus s);
 
 struct SolveTimings {
     double assembly = 0, factorization = 0, solve = 0, line_search = 0, total = 0;  // seconds
+    SolveTimings& operator+=(const SolveTimings& o) {
+        assembly += o.assembly, factorization += o.factorization, solve += o.solve, line_search += o.line_search;
+        total += o.total;
+        return *this;
+    }
 };
 
 struct SolveResult {
