@@ -2,7 +2,7 @@
 // scheme) relaxed dry, wetted at all crossings and relaxed under capillary load with mobile bridges.
 // Prints one JSON line per run with the time split: dry Newton, wet Newton, event handling, pore analysis.
 //   bench_wet [N=1000] [q=10] [beta=0.01] [max_rounds=1000] [newton_max_iter=500] [scheme=seed] [seed=1] [move_margin=0.1]
-//             [round_iterations=10] [warm_start=1]
+//             [round_iterations=10] [warm_start=1] [newton_ldl=1]
 // The "newton" block sums the wet solves' time split over all rounds.
 // Environment: BENCH_VERBOSE=1 prints a line per active-set round, BENCH_NEWTON_VERBOSE=1 a line per Newton iteration.
 #include <chrono>
@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
     const double move_margin = argc > 8 ? std::atof(argv[8]) : ActiveSetOptions{}.move_margin;
     const int round_iterations = argc > 9 ? std::atoi(argv[9]) : ActiveSetOptions{}.round_iterations;
     const bool warm_start = argc > 10 ? std::atoi(argv[10]) != 0 : ActiveSetOptions{}.warm_start;
+    const bool newton_ldl = argc > 11 ? std::atoi(argv[11]) != 0 : ActiveSetOptions{}.newton_ldl;
     const auto t0 = std::chrono::steady_clock::now();
     MikadoParams mp;
     mp.q = q, mp.pl = 0.5, mp.seed = seed;
@@ -44,6 +45,7 @@ int main(int argc, char** argv) {
     opt.active_set.move_margin = move_margin;
     opt.active_set.round_iterations = round_iterations;
     opt.active_set.warm_start = warm_start;
+    opt.active_set.newton_ldl = newton_ldl;
     opt.active_set.verbose = std::getenv("BENCH_VERBOSE") != nullptr;  // a line per active-set round on stderr
     opt.solver_options.tol = 1e-8;
     opt.solver_options.max_iter = max_iter;

@@ -6,6 +6,7 @@
 
 #include "common.hpp"
 #include "fibernet/util/error.hpp"
+#include "fibernet/util/parallel.hpp"
 
 int main(int argc, char** argv) {
     using namespace fibernet;
@@ -23,6 +24,7 @@ int main(int argc, char** argv) {
     cli::register_wet(app);
     cli::register_sweep(app);
     try {
+        (void)thread_count();  // a bad FIBERNET_THREADS is an input error before any work
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);

@@ -177,6 +177,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         r.get("free_box_tol", s.wet.free_box_tol);
         r.get("max_rounds", s.wet.max_rounds);
         r.get("round_iterations", s.wet.round_iterations);
+        r.get("newton_ldl", s.wet.newton_ldl);
         r.finish();
     }
     s.check();

@@ -67,6 +67,7 @@ CholmodLLT& NewtonSolver::factorization_for(const Eigen::SparseMatrix<double>& H
         llt_ = std::make_unique<CholmodLLT>();
         analyzed_ = H;
         if (H.rows() > 0) llt_->analyze(H);
+        ldl_.reset();  // analyzed on first use (SolverOptions::ldl)
         if (seconds) *seconds = since(t0);
     }
     return *llt_;
@@ -86,6 +87,13 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
     double t_analysis = 0;
     CholmodLLT& llt = factorization_for(H, &t_analysis);
     r.timings.factorization += t_analysis;
+    if (opt_.ldl && n > 0 && !ldl_) {
+        const auto t0 = Clock::now();
+        ldl_ = std::make_unique<CholmodLDL>();
+        ldl_->analyze(H);
+        r.timings.factorization += since(t0);
+    }
+    CholmodLDL* ldl = opt_.ldl ? ldl_.get() : nullptr;
 
     Eigen::VectorXd g(n), gt(n), d(n), qt(n);
     int start_rung = 0;
@@ -177,7 +185,23 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
             ++r.evaluations;
             projected = true;
         };
-        if (start_rung <= 0) {  // H holds the exact Hessian (assembled with projected = start_rung >= 1)
+        if (start_rung <= 0 && ldl) {
+            // Rung 0 by LDL^T (SolverOptions::ldl): the exact H + mu I with its negative pivots flipped, a positive
+            // definite matrix equal to H + mu I wherever H is positive definite. Negative curvature is handled where
+            // it occurs: no escalated shift for the whole Hessian, which on a large wet network is set by its worst
+            // spot and shortens the step of every other part.
+            auto tf = Clock::now();
+            const bool ok = ldl->factorize(H, mu);
+            r.timings.factorization += since(tf);
+            ++r.factorizations;
+            if (ok) {
+                auto ts = Clock::now();
+                d = -ldl->solve_modified(g, mu);
+                r.timings.solve += since(ts);
+                if (d.allFinite() && g.dot(d) < -kDescent * gnorm * d.norm()) rung = 0, shift = mu;
+            }
+        }
+        if (start_rung <= 0 && rung < 0) {  // H holds the exact Hessian (assembled with projected = start_rung >= 1)
             if (try_factor(mu)) {
                 rung = 0, shift = mu;
             } else {

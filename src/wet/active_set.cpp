@@ -355,6 +355,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         double t0 = now();
         so.max_iter = capped ? opt.round_iterations : budget;
         so.warm_start = (resume && opt.warm_start) || restore.saved.warm_start;  // Newton: keep its adapted shift
+        so.ldl = (opt.newton_ldl && params.beta > 0) || restore.saved.ldl;        // beta = 0: the dry solve, bit for bit
         r.last = solver.minimize(W, q);
         r.seconds_solve += now() - t0;
         r.solver_iterations += r.last.iterations;

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "fibernet/util/parallel.hpp"
+
 namespace fibernet {
 
 WetEnergy::WetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, std::vector<Bridge> bridges, WetParams params)
@@ -80,21 +82,38 @@ double WetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::Spar
     }
     const Eigen::VectorXd x = dry_.positions(q, F_);
     const Eigen::Matrix2d B = F_ * dry_.model().box.B0();
-    Vector16d ge;
-    Matrix16d he;
-    for (size_t k = 0; k < elements_.size(); ++k) {
-        const BridgeElement& e = elements_[k];
-        const Vector16d X = element_coordinates(e, x, B);
-        E += bridge_element_energy(e, X, params_.beta, params_.law, g ? &ge : nullptr, H ? &he : nullptr, psd);
-        if (g)
-            for (int a = 0; a < 16; ++a) {
-                const int r = e.node[a / 2] < 0 ? -1 : dry_.dof(e.node[a / 2], a % 2);
-                if (r >= 0) (*g)[r] += ge[a];
+    // Elements in chunks: each chunk's elements are evaluated in parallel into their own slots, then added in element
+    // order, so the sums (and every solve) are bit for bit the same for any thread count.
+    const size_t ne = elements_.size();
+    const size_t chunk = std::min(ne, kChunk);
+    const int threads = ne >= kParallelMin ? thread_count() : 1;
+    chunk_E_.resize(chunk);
+    if (g) chunk_g_.resize(chunk);
+    if (H) chunk_H_.resize(chunk);
+    for (size_t c0 = 0; c0 < ne; c0 += chunk) {
+        const size_t c1 = std::min(ne, c0 + chunk);
+        parallel_ranges(c1 - c0, threads, [&](size_t lo, size_t hi) {
+            for (size_t i = lo; i < hi; ++i) {
+                const BridgeElement& e = elements_[c0 + i];
+                chunk_E_[i] = bridge_element_energy(e, element_coordinates(e, x, B), params_.beta, params_.law,
+                                                    g ? &chunk_g_[i] : nullptr, H ? &chunk_H_[i] : nullptr, psd);
             }
-        if (H) {
-            const int* sl = &bridge_slots_[256 * k];
-            for (int i = 0; i < 256; ++i)
-                if (sl[i] >= 0) hv[sl[i]] += he(i / 16, i % 16);
+        });
+        for (size_t k = c0; k < c1; ++k) {
+            const size_t i = k - c0;
+            const BridgeElement& e = elements_[k];
+            E += chunk_E_[i];
+            if (g)
+                for (int a = 0; a < 16; ++a) {
+                    const int r = e.node[a / 2] < 0 ? -1 : dry_.dof(e.node[a / 2], a % 2);
+                    if (r >= 0) (*g)[r] += chunk_g_[i][a];
+                }
+            if (H) {
+                const int* sl = &bridge_slots_[256 * k];
+                const Matrix16d& he = chunk_H_[i];
+                for (int j = 0; j < 256; ++j)
+                    if (sl[j] >= 0) hv[sl[j]] += he(j / 16, j % 16);
+            }
         }
     }
     return E;

@@ -76,13 +76,14 @@ public:
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override {
         caps.push_back(opt_.max_iter);
         warm.push_back(opt_.warm_start);
+        ldl.push_back(opt_.ldl);
         inner_.options() = opt_;
         const SolveResult r = inner_.minimize(f, q);
         iterations.push_back(r.iterations);
         return r;
     }
     std::vector<int> caps, iterations;
-    std::vector<bool> warm;
+    std::vector<bool> warm, ldl;
 
 private:
     SolverOptions opt_;
@@ -113,7 +114,9 @@ TEST_CASE("wet relaxation: rounds are capped while the bridge set changes, then 
         // The solver's own options are back as they were.
         CHECK(s.options().max_iter == 300);
         CHECK(!s.options().warm_start);
+        CHECK(!s.options().ldl);
         REQUIRE(s.caps.size() == static_cast<size_t>(r.rounds));
+        for (bool l : s.ldl) CHECK(l);  // Newton's LDL^T rung on every round (ActiveSetOptions::newton_ldl)
         CHECK(!s.warm[0]);
         int capped = 0;
         for (int k = 0; k < r.rounds; ++k) {
@@ -133,4 +136,28 @@ TEST_CASE("wet relaxation: rounds are capped while the bridge set changes, then 
         }
         if (cap > 0) CHECK(capped >= 1);  // the cap did stop a round here
     }
+}
+
+TEST_CASE("wet relaxation: Newton's LDL^T rung only under capillary load, and only if asked", "[wet][relax]") {
+    const Network net = mikado(2.5, 6, 0.8, 2);
+    const Model m = model_of(net, 10);
+    NetworkEnergy e(m);
+    const auto initial = wet_crossings(net, m, m.x, m.box.B0(), {});
+    for (double beta : {0.0, 0.5})
+        for (bool use : {true, false}) {
+            WetParams p;
+            p.beta = beta;
+            SolverOptions so;
+            so.tol = 1e-9, so.max_iter = 300;
+            Recording s(so);
+            ActiveSetOptions opt;
+            opt.newton_ldl = use;
+            Eigen::VectorXd q = e.dofs(m.x);
+            const ActiveSetResult r = relax_wet(e, Eigen::Matrix2d::Identity(), p, initial, s, q, opt);
+            INFO("beta " << beta << ", newton_ldl " << use << ": " << r.message);
+            CHECK(r.stable);
+            REQUIRE(!s.ldl.empty());
+            for (bool l : s.ldl) CHECK(l == (use && beta > 0));  // beta = 0 stays the dry solve, bit for bit
+            CHECK(!s.options().ldl);
+        }
 }

@@ -7,6 +7,7 @@
 #include "../energy/fd.hpp"
 #include "fibernet/wet/active_set.hpp"
 #include "fibernet/wet/wet_energy.hpp"
+#include "fibernet/util/parallel.hpp"
 #include "wet_fixtures.hpp"
 
 using namespace fibernet;
@@ -146,4 +147,28 @@ TEST_CASE("wet energy: the projected Hessian is positive semidefinite", "[wet][h
     const Eigen::VectorXd ev2 =
         Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Eigen::MatrixXd(Hu2.selfadjointView<Eigen::Upper>())).eigenvalues();
     CHECK(ev2.minCoeff() < -1e-6);
+}
+
+TEST_CASE("wet energy: bit for bit the same on any number of threads", "[wet][parallel]") {
+    // Enough bridges (>= 1024) for the parallel element loop, and more than one chunk of 2048.
+    const Model m = model_of(mikado(12, 10, 0.5, 4), 10);
+    NetworkEnergy dry(m);
+    const Eigen::VectorXd q = perturb(dry.dofs(m.x), 0.01, 9);
+    WetParams p;
+    p.beta = 0.3;
+    WetEnergy W(dry, Eigen::Matrix2d::Identity(), segment_crossings(m, dry.positions(q, Eigen::Matrix2d::Identity()), m.box.B0()), p);
+    REQUIRE(W.bridges().size() > 2048);
+    auto evaluate = [&](int threads, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H) {
+        set_thread_count(threads);
+        H = W.hessian_pattern();
+        return W.hessian(q, g, H, false);
+    };
+    Eigen::VectorXd g1, g3;
+    Eigen::SparseMatrix<double> H1, H3;
+    const double e1 = evaluate(1, g1, H1), e3 = evaluate(3, g3, H3);
+    set_thread_count(thread_count_default());
+    CHECK(e1 == e3);
+    CHECK((g1.array() == g3.array()).all());
+    CHECK(std::equal(H1.valuePtr(), H1.valuePtr() + H1.nonZeros(), H3.valuePtr()));
+    CHECK(W.value(q) == e1);
 }

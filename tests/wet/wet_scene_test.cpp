@@ -24,6 +24,8 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
     CHECK(r.wet.max_rounds == 50);
     CHECK(r.wet.round_iterations == 0);
     CHECK(parse_scene("", "empty.toml").wet.round_iterations == 10);
+    CHECK(parse_scene("", "empty.toml").wet.newton_ldl);
+    CHECK(!parse_scene("[wet]\nnewton_ldl = false\n", "l.toml").wet.newton_ldl);
     struct Bad {
         std::string toml, needle;
     };
@@ -37,6 +39,7 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
                          Bad{"[wet]\nmax_rounds = 0\n", "[wet].max_rounds = 0"},
                          Bad{"[wet]\nround_iterations = -1\n", "[wet].round_iterations = -1"},
                          Bad{"[wet]\nround_iterations = 2.5\n", "[wet].round_iterations"},
+                         Bad{"[wet]\nnewton_ldl = 1\n", "[wet].newton_ldl"},
                          Bad{"[wet]\nlaw = \"/nonexistent/law.txt\"\n", "/nonexistent/law.txt"}}) {
         INFO(b.toml);
         try {

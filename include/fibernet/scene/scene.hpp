@@ -31,6 +31,7 @@ struct WetSettings {
     double free_box_tol = 1e-3;           // |sigma| / sigma_c below which the free box has converged, > 0
     int max_rounds = 1000;      // active-set rounds (bridge-set updates) per relaxation, >= 1
     int round_iterations = 10;  // Newton iterations per round while the set changes (0: solve each round to the end)
+    bool newton_ldl = true;     // Newton's first rung by LDL^T with flipped negative pivots (docs/wet.md)
 };
 
 struct Scene {

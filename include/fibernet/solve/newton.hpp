@@ -9,6 +9,10 @@
 //                              translations, floppy clusters), raised after backtracking; floored at
 //                              mu_floor = 1e-13 * mean diag(H) (round-off scale of a null pivot). If H + mu I does
 //                              not factor, the shift on the exact H is raised 4x at a time up to 0.2 mean diag;
+//      With SolverOptions::ldl, rung 0 is instead a simplicial LDL^T of H + mu I with its negative pivots replaced by
+//      their magnitudes (cholmod_ldl.hpp): negative curvature is handled where it occurs, with no shift for the rest
+//      of the Hessian (the wet relaxations of large networks, docs/solvers.md); the escalation follows only if that
+//      fails (a zero pivot, or no descent direction);
 //   1. per-element PSD-projected H + mu I  (buckled or compressed segments make H indefinite);
 //   2. projected H + lambda I, lambda = 1e-8 * mean diag(H) * 10^j, j = 0..10;
 //   3. steepest descent d = -g.
@@ -19,6 +23,7 @@
 #include <memory>
 #include <vector>
 
+#include "fibernet/solve/cholmod_ldl.hpp"
 #include "fibernet/solve/cholmod_llt.hpp"
 #include "fibernet/solve/solver.hpp"
 
@@ -48,6 +53,7 @@ private:
     std::vector<int> rungs_;
     std::vector<double> shifts_;
     std::unique_ptr<CholmodLLT> llt_;
+    std::unique_ptr<CholmodLDL> ldl_;
     Eigen::SparseMatrix<double> analyzed_;  // the pattern llt_ was analyzed for
     double shift_rel_ = -1;                  // the last minimize()'s final shift / mean diag (for warm_start)
 };

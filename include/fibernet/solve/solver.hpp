@@ -16,6 +16,8 @@ struct SolverOptions {
     bool verbose = false;    // progress to stderr
     bool warm_start = false; // start from the state the previous minimize() adapted (Newton: its shift), for a caller
                              // that resumes an interrupted solve of a slightly changed objective; others ignore it
+    bool ldl = false;        // Newton: rung 0 by a simplicial LDL^T of the exact H + mu I with negative pivots flipped
+                             // (cholmod_ldl.hpp) instead of the escalated shift; others ignore it
 };
 
 class Solver {

@@ -49,6 +49,10 @@ struct ActiveSetOptions {
     // "Rounds") and takes 2x the Newton iterations. run_wet ignores it for first-order solvers (cheap, many iterations).
     int round_iterations = 10;
     bool warm_start = true;       // a round after a cut one resumes the solver's adapted state (SolverOptions::warm_start)
+    // Newton's rung 0 by LDL^T with flipped negative pivots (SolverOptions::ldl) while beta > 0: a large wet network
+    // is indefinite somewhere at almost every iteration, and the escalated shift that the whole Hessian otherwise
+    // gets shortens every other part's step (docs/wet.md, "Newton on wet networks"). Other solvers ignore it.
+    bool newton_ldl = true;
     bool form_new = true;        // give new crossings and new contacts bridges
     double contact_distance = 0;  // seed units; 0: the fiber diameter 2 r = 2 ls / a
     double contact_angle_deg = 10;

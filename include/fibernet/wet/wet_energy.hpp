@@ -59,6 +59,11 @@ private:
     std::vector<int> dry_slot_;     // dry pattern value index -> union value index
     std::vector<int> bridge_slots_; // 256 per bridge: union value index of local (a, b) with row <= col, else -1
     EnergyEval eval_;
+    // Per-chunk element results (eval): filled in parallel, summed in element order.
+    static constexpr size_t kChunk = 2048, kParallelMin = 1024;
+    std::vector<double> chunk_E_;
+    std::vector<Vector16d, Eigen::aligned_allocator<Vector16d>> chunk_g_;
+    std::vector<Matrix16d, Eigen::aligned_allocator<Matrix16d>> chunk_H_;
 };
 
 }  // namespace fibernet

@@ -1,0 +1,36 @@
+#pragma once
+// CHOLMOD's simplicial LDL^T of a symmetric, possibly indefinite matrix H + shift I (no pivoting: P (H + shift I) P^T
+// = L D L^T with L unit lower triangular and D diagonal, fill-reducing P), and solves with the pivots modified to
+// max(|D_j|, floor): a positive definite L |D| L^T that agrees with H + shift I wherever its pivots are positive.
+// Newton's first rung (newton.hpp): negative curvature is handled where it occurs, instead of by one shift of the
+// whole Hessian, so that a buckling spot does not shorten the step of every other part of a large network.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+
+namespace fibernet {
+
+class CholmodLDL {
+public:
+    CholmodLDL();
+    ~CholmodLDL();
+    CholmodLDL(const CholmodLDL&) = delete;
+    CholmodLDL& operator=(const CholmodLDL&) = delete;
+
+    // Symbolic analysis of an upper-triangular CSC pattern (values ignored).
+    void analyze(const Eigen::SparseMatrix<double>& upper);
+    bool analyzed() const;
+    // Numeric LDL^T of H + shift I (H with the analyzed pattern). False on a zero or non-finite pivot.
+    bool factorize(const Eigen::SparseMatrix<double>& upper, double shift = 0.0);
+    // Pivots of the last factorization that were negative, and the smallest one.
+    int negative_pivots() const;
+    double min_pivot() const;
+    // x = P^T L^-T Dm^-1 L^-1 P b with Dm_j = max(|D_j|, floor) (floor > 0).
+    Eigen::VectorXd solve_modified(const Eigen::VectorXd& b, double floor) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fibernet

@@ -1,0 +1,121 @@
+#include "fibernet/solve/cholmod_ldl.hpp"
+
+#include <cholmod.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace fibernet {
+
+struct CholmodLDL::Impl {
+    cholmod_common c;
+    cholmod_factor* L = nullptr;
+    bool ok = false;
+    int negative = 0;
+    double min_pivot = 0;
+
+    Impl() {
+        cholmod_start(&c);
+        c.supernodal = CHOLMOD_SIMPLICIAL;  // CHOLMOD's supernodal factorization is LL^T only
+        c.final_ll = 0;
+        c.print = 0;
+        c.error_handler = nullptr;
+    }
+    ~Impl() {
+        if (L) cholmod_free_factor(&L, &c);
+        cholmod_finish(&c);
+    }
+};
+
+namespace {
+cholmod_sparse view(const Eigen::SparseMatrix<double>& A) {
+    if (!A.isCompressed()) throw std::logic_error("CholmodLDL: matrix must be compressed");
+    cholmod_sparse s{};
+    s.nrow = s.ncol = static_cast<size_t>(A.rows());
+    s.nzmax = static_cast<size_t>(A.nonZeros());
+    s.p = const_cast<int*>(A.outerIndexPtr());
+    s.i = const_cast<int*>(A.innerIndexPtr());
+    s.x = const_cast<double*>(A.valuePtr());
+    s.stype = 1;
+    s.itype = CHOLMOD_INT;
+    s.xtype = CHOLMOD_REAL;
+    s.dtype = CHOLMOD_DOUBLE;
+    s.sorted = 1;
+    s.packed = 1;
+    return s;
+}
+
+cholmod_dense dense_view(Eigen::VectorXd& v) {
+    cholmod_dense d{};
+    d.nrow = d.d = d.nzmax = static_cast<size_t>(v.size());
+    d.ncol = 1;
+    d.x = v.data();
+    d.xtype = CHOLMOD_REAL;
+    d.dtype = CHOLMOD_DOUBLE;
+    return d;
+}
+}  // namespace
+
+CholmodLDL::CholmodLDL() : impl_(std::make_unique<Impl>()) {}
+CholmodLDL::~CholmodLDL() = default;
+
+bool CholmodLDL::analyzed() const { return impl_->L != nullptr; }
+
+void CholmodLDL::analyze(const Eigen::SparseMatrix<double>& upper) {
+    if (impl_->L) cholmod_free_factor(&impl_->L, &impl_->c);
+    cholmod_sparse A = view(upper);
+    impl_->L = cholmod_analyze(&A, &impl_->c);
+    if (!impl_->L) throw std::runtime_error("CHOLMOD symbolic analysis failed (status " + std::to_string(impl_->c.status) + ")");
+    impl_->ok = false;
+}
+
+bool CholmodLDL::factorize(const Eigen::SparseMatrix<double>& upper, double shift) {
+    if (!impl_->L || impl_->L->n != static_cast<size_t>(upper.rows())) analyze(upper);
+    cholmod_sparse A = view(upper);
+    double beta[2] = {shift, 0.0};
+    impl_->c.status = CHOLMOD_OK;
+    const int r = cholmod_factorize_p(&A, beta, nullptr, 0, impl_->L, &impl_->c);
+    const cholmod_factor* L = impl_->L;
+    impl_->ok = r && impl_->c.status == CHOLMOD_OK && L->minor == L->n && !L->is_ll && !L->is_super;
+    impl_->negative = 0;
+    impl_->min_pivot = std::numeric_limits<double>::infinity();
+    if (!impl_->ok) return false;
+    const double* x = static_cast<const double*>(L->x);
+    const int* p = static_cast<const int*>(L->p);
+    for (size_t j = 0; j < L->n; ++j) {
+        const double d = x[p[j]];  // simplicial LDL^T: D_j is the first entry of column j
+        if (!std::isfinite(d) || d == 0) return impl_->ok = false;
+        impl_->negative += d < 0;
+        impl_->min_pivot = std::min(impl_->min_pivot, d);
+    }
+    return true;
+}
+
+int CholmodLDL::negative_pivots() const { return impl_->negative; }
+double CholmodLDL::min_pivot() const { return impl_->min_pivot; }
+
+Eigen::VectorXd CholmodLDL::solve_modified(const Eigen::VectorXd& b, double floor) const {
+    if (!impl_->ok) throw std::logic_error("CholmodLDL::solve_modified without a successful factorization");
+    const cholmod_factor* L = impl_->L;
+    Eigen::VectorXd v = b;
+    auto apply = [&](int sys) {
+        cholmod_dense B = dense_view(v);
+        cholmod_dense* X = cholmod_solve(sys, const_cast<cholmod_factor*>(L), &B, &impl_->c);
+        if (!X) throw std::runtime_error("CHOLMOD solve failed (status " + std::to_string(impl_->c.status) + ")");
+        std::copy(static_cast<double*>(X->x), static_cast<double*>(X->x) + v.size(), v.data());
+        cholmod_free_dense(&X, &impl_->c);
+    };
+    apply(CHOLMOD_P);
+    apply(CHOLMOD_L);
+    const double* x = static_cast<const double*>(L->x);
+    const int* p = static_cast<const int*>(L->p);
+    for (size_t j = 0; j < L->n; ++j) v[j] /= std::max(std::abs(x[p[j]]), floor);
+    apply(CHOLMOD_Lt);
+    apply(CHOLMOD_Pt);
+    return v;
+}
+
+}  // namespace fibernet
