@@ -87,6 +87,7 @@ nlohmann::json free_box_json(const FreeBoxResult& f, const FreeBoxOptions& o) {
               {"iterations", f.iterations},
               {"relaxations", f.relaxations},
               {"stiffness_solves", f.stiffness_solves},
+              {"stiffness_retries", f.stiffness_retries},
               {"solver_iterations", f.solver_iterations},
               {"energy", energy_json(f.energy)},
               {"bridges", f.bridges.size()},

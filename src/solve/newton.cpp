@@ -164,8 +164,6 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         dm_last = dm;
         const double mu = std::max(kMuFloor * dm, mu_lm);
         const double gnorm = g.norm();
-        int rung = -1;
-        double shift = 0;
         auto try_factor = [&](double s) {
             auto tf = Clock::now();
             const bool ok = llt.factorize(H, s);
@@ -185,79 +183,88 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
             ++r.evaluations;
             projected = true;
         };
-        if (start_rung <= 0 && ldl) {
-            // Rung 0 by LDL^T (SolverOptions::ldl): the exact H + mu I with its negative pivots flipped, a positive
-            // definite matrix equal to H + mu I wherever H is positive definite. Negative curvature is handled where
-            // it occurs: no escalated shift for the whole Hessian, which on a large wet network is set by its worst
-            // spot and shortens the step of every other part.
-            auto tf = Clock::now();
-            const bool ok = ldl->factorize(H, mu);
-            r.timings.factorization += since(tf);
-            ++r.factorizations;
-            if (ok) {
-                auto ts = Clock::now();
-                d = -ldl->solve_modified(g, mu);
-                r.timings.solve += since(ts);
-                if (d.allFinite() && g.dot(d) < -kDescent * gnorm * d.norm()) rung = 0, shift = mu;
-            }
-        }
-        if (start_rung <= 0 && rung < 0) {  // H holds the exact Hessian (assembled with projected = start_rung >= 1)
-            if (try_factor(mu)) {
-                rung = 0, shift = mu;
-            } else {
-                // Exact H + lambda I with lambda raised 4x at a time (Nocedal & Wright, Alg. 3.3) before giving up
-                // the exact Hessian: negative curvature (capillary torques, buckling) is kept in every direction but
-                // the few unstable ones, where projecting each element's block would overstate the stiffness of the
-                // whole assembly and turn Newton into a linearly converging method (docs/moduli.md, "Newton ladder").
-                double lam = std::max(kExactGrow * mu, kLambda0 * dm);
-                for (; lam <= kExactCap * dm && rung < 0; lam *= kExactGrow)
-                    if (try_factor(lam)) rung = 0, shift = lam;
-            }
-        }
-        if (rung < 0 && start_rung <= 1) {
-            make_projected();
-            if (try_factor(mu)) rung = 1, shift = mu;
-        }
-        if (rung < 0) {
-            make_projected();
-            double lam = std::max(mu, kLambda0 * dm);
-            for (int j = 0; j < kLambdaSteps && rung < 0; ++j, lam *= 10)
-                if (try_factor(lam)) rung = 2, shift = lam;
-        }
-        if (rung < 0) rung = 3, d = -g / dm;
-
-        // Armijo backtracking; +inf/NaN is a failed trial.
-        auto tl = Clock::now();
-        double alpha = 1, ft = 0;
-        bool accepted = false;
-        for (int attempt = 0; attempt < 2 && !accepted; ++attempt) {
-            if (attempt == 1) {  // the Newton-type direction failed: one steepest-descent try
-                if (rung == 3) break;
-                rung = 3, d = -g / dm;
-            }
-            const double gd = g.dot(d);
-            alpha = 1;
-            for (int k = 0; k < kMaxHalvings; ++k, alpha *= 0.5) {
-                qt = q + alpha * d;
-                ft = f.value(qt);
-                ++r.evaluations;
-                if (!std::isfinite(ft)) continue;
-                if (ft <= fq + kArmijo * alpha * gd) {
-                    accepted = true;
-                    break;
+        // Two passes: with SolverOptions::ldl the first takes the LDL^T direction; if its line search fails (a poor
+        // flipped-curvature direction), the second redoes the iteration with the shifted LL^T ladder.
+        int rung = -1;
+        double shift = 0, alpha = 1, ft = 0;
+        bool accepted = false, retry = false;
+        for (int pass = 0; pass < 2 && !accepted; ++pass) {
+            if (pass == 1 && !retry) break;
+            bool used_ldl = false;
+            rung = -1, shift = 0;
+            if (start_rung <= 0 && ldl && pass == 0) {
+                // Rung 0 by LDL^T (SolverOptions::ldl): the exact H + mu I with its negative pivots flipped, a positive
+                // definite matrix equal to H + mu I wherever H is positive definite. Negative curvature is handled where
+                // it occurs: no escalated shift for the whole Hessian, which on a large wet network is set by its worst
+                // spot and shortens the step of every other part.
+                auto tf = Clock::now();
+                const bool ok = ldl->factorize(H, mu);
+                r.timings.factorization += since(tf);
+                ++r.factorizations;
+                if (ok) {
+                    auto ts = Clock::now();
+                    d = -ldl->solve_modified(g, mu);
+                    r.timings.solve += since(ts);
+                    if (d.allFinite() && g.dot(d) < -kDescent * gnorm * d.norm()) rung = 0, shift = mu, used_ldl = true;
                 }
-                // Round-off regime: the predicted decrease is below what the energy can resolve.
-                if (k == 0 && ft - fq <= 1e-12 * (1 + std::abs(fq)) && -gd <= 1e-10 * (1 + std::abs(fq))) {
-                    f.gradient(qt, gt);
+            }
+            if (start_rung <= 0 && rung < 0) {  // H holds the exact Hessian (assembled with projected = start_rung >= 1)
+                if (try_factor(mu)) {
+                    rung = 0, shift = mu;
+                } else {
+                    // Exact H + lambda I with lambda raised 4x at a time (Nocedal & Wright, Alg. 3.3) before giving up
+                    // the exact Hessian: negative curvature (capillary torques, buckling) is kept in every direction but
+                    // the few unstable ones, where projecting each element's block would overstate the stiffness of the
+                    // whole assembly and turn Newton into a linearly converging method (docs/moduli.md, "Newton ladder").
+                    double lam = std::max(kExactGrow * mu, kLambda0 * dm);
+                    for (; lam <= kExactCap * dm && rung < 0; lam *= kExactGrow)
+                        if (try_factor(lam)) rung = 0, shift = lam;
+                }
+            }
+            if (rung < 0 && start_rung <= 1) {
+                make_projected();
+                if (try_factor(mu)) rung = 1, shift = mu;
+            }
+            if (rung < 0) {
+                make_projected();
+                double lam = std::max(mu, kLambda0 * dm);
+                for (int j = 0; j < kLambdaSteps && rung < 0; ++j, lam *= 10)
+                    if (try_factor(lam)) rung = 2, shift = lam;
+            }
+            if (rung < 0) rung = 3, d = -g / dm;
+
+            // Armijo backtracking; +inf/NaN is a failed trial.
+            auto tl = Clock::now();
+            for (int attempt = 0; attempt < 2 && !accepted; ++attempt) {
+                if (attempt == 1) {  // the Newton-type direction failed: one steepest-descent try (after the LDL^T retry)
+                    if (rung == 3 || used_ldl) break;
+                    rung = 3, d = -g / dm;
+                }
+                const double gd = g.dot(d);
+                alpha = 1;
+                for (int k = 0; k < kMaxHalvings; ++k, alpha *= 0.5) {
+                    qt = q + alpha * d;
+                    ft = f.value(qt);
                     ++r.evaluations;
-                    if (gt.allFinite() && gt.lpNorm<Eigen::Infinity>() < gmax) {
+                    if (!std::isfinite(ft)) continue;
+                    if (ft <= fq + kArmijo * alpha * gd) {
                         accepted = true;
                         break;
                     }
+                    // Round-off regime: the predicted decrease is below what the energy can resolve.
+                    if (k == 0 && ft - fq <= 1e-12 * (1 + std::abs(fq)) && -gd <= 1e-10 * (1 + std::abs(fq))) {
+                        f.gradient(qt, gt);
+                        ++r.evaluations;
+                        if (gt.allFinite() && gt.lpNorm<Eigen::Infinity>() < gmax) {
+                            accepted = true;
+                            break;
+                        }
+                    }
                 }
             }
+            r.timings.line_search += since(tl);
+            retry = !accepted && used_ldl;
         }
-        r.timings.line_search += since(tl);
         rungs_.push_back(rung);
         shifts_.push_back(rung <= 2 ? shift : 0.0);
         if (opt_.verbose)

@@ -66,30 +66,6 @@ TEST_CASE("wet relaxation: the active-set loop terminates and reports", "[wet][r
         }
 }
 
-namespace {
-// Passes each call to Newton with the options the loop set, and records them.
-class Recording : public Solver {
-public:
-    explicit Recording(SolverOptions o) : opt_(o), inner_(o) {}
-    std::string name() const override { return "newton"; }
-    SolverOptions& options() override { return opt_; }
-    SolveResult minimize(Objective& f, Eigen::VectorXd& q) override {
-        caps.push_back(opt_.max_iter);
-        warm.push_back(opt_.warm_start);
-        ldl.push_back(opt_.ldl);
-        inner_.options() = opt_;
-        const SolveResult r = inner_.minimize(f, q);
-        iterations.push_back(r.iterations);
-        return r;
-    }
-    std::vector<int> caps, iterations;
-    std::vector<bool> warm, ldl;
-
-private:
-    SolverOptions opt_;
-    NewtonSolver inner_;
-};
-}  // namespace
 
 TEST_CASE("wet relaxation: rounds are capped while the bridge set changes, then solved to the end", "[wet][relax]") {
     const Network net = mikado(2.5, 6, 0.8, 2);

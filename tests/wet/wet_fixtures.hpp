@@ -7,6 +7,7 @@
 #include "fibernet/energy/network_energy.hpp"
 #include "fibernet/model/discretize.hpp"
 #include "fibernet/network/mikado.hpp"
+#include "fibernet/solve/newton.hpp"
 #include "fibernet/util/random.hpp"
 #include "fibernet/wet/wetting.hpp"
 
@@ -49,4 +50,28 @@ inline Network mikado(double L, double q, double pl, std::uint64_t seed) {
     p.L = L, p.q = q, p.pl = pl, p.seed = seed;
     return generate_mikado(p);
 }
+
+// Passes each call to Newton with the options the loop set, and records them.
+class Recording : public Solver {
+public:
+    explicit Recording(SolverOptions o) : opt_(o), inner_(o) {}
+    std::string name() const override { return "newton"; }
+    SolverOptions& options() override { return opt_; }
+    SolveResult minimize(Objective& f, Eigen::VectorXd& q) override {
+        caps.push_back(opt_.max_iter);
+        warm.push_back(opt_.warm_start);
+        ldl.push_back(opt_.ldl);
+        inner_.options() = opt_;
+        const SolveResult r = inner_.minimize(f, q);
+        iterations.push_back(r.iterations);
+        return r;
+    }
+    std::vector<int> caps, iterations;
+    std::vector<bool> warm, ldl;
+
+private:
+    SolverOptions opt_;
+    NewtonSolver inner_;
+};
+
 }  // namespace wetfix
