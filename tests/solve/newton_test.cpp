@@ -408,3 +408,52 @@ TEST_CASE("newton: with ldl, negative curvature is handled where it occurs", "[n
         CHECK(std::abs(q[2 * i + 1]) < 1e-10);
     }
 }
+
+namespace {
+// f = q^T H q / 2 + b^T q with H = [[-1, 0.5], [0.5, 2]] (indefinite), and +inf below the line y = x / 4 for x < 0 (a
+// wall, like a collapsed segment). From q = 0 the LDL^T direction with flipped pivots is along (-2, -1), into the wall,
+// as is steepest descent; the projected rung (Hp = diag(0.1, 2)) points along (-20, -1), which is open.
+class Walled : public Objective {
+public:
+    Walled() : P_(2, 2) {
+        P_.insert(0, 0) = 0, P_.insert(0, 1) = 0, P_.insert(1, 1) = 0;
+        P_.makeCompressed();
+    }
+    int size() const override { return 2; }
+    double value(const Eigen::VectorXd& q) override {
+        if (q[0] < 0 && q[1] < q[0] / 4) return HUGE_VAL;
+        return 0.5 * q.dot(H() * q) + q.sum();
+    }
+    double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override {
+        g = H() * q + Eigen::Vector2d(1, 1);
+        return value(q);
+    }
+    double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool project) override {
+        H = P_;
+        H.coeffRef(0, 0) = project ? 0.1 : -1;
+        H.coeffRef(0, 1) = project ? 0 : 0.5;
+        H.coeffRef(1, 1) = 2;
+        return gradient(q, g);
+    }
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return P_; }
+
+private:
+    static Eigen::Matrix2d H() { return (Eigen::Matrix2d() << -1, 0.5, 0.5, 2).finished(); }
+    Eigen::SparseMatrix<double> P_;
+};
+}  // namespace
+
+TEST_CASE("newton: an LDL^T direction that fails its line search is retried with the shifted ladder", "[newton][ldl]") {
+    Walled f;
+    fibernet::SolverOptions o;
+    o.max_iter = 1;
+    o.ldl = true;
+    fibernet::NewtonSolver newton(o);
+    Eigen::VectorXd q = Eigen::Vector2d::Zero();
+    const fibernet::SolveResult r = newton.minimize(f, q);
+    INFO(r.message);
+    CHECK(r.status == fibernet::SolveStatus::IterationLimit);  // a step was taken
+    REQUIRE(newton.rungs().size() == 1);
+    CHECK(newton.rungs()[0] == 1);  // by the projected rung, after the LDL^T direction (and steepest descent) hit the wall
+    CHECK(f.value(q) < 0);
+}
