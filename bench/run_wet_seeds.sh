@@ -7,5 +7,5 @@
 set -euo pipefail
 B=${1:?build dir}; N=${2:-100}; S=${3:-6}; S0=${S0:-1}; BETA=${4:-0.01}; SCHEME=${5:-seed}; MARGIN=${6:-0.1}; ROUNDIT=${7:-10}; WARM=${8:-1}; LDL=${9:-1}
 for s in $(seq "$S0" "$S"); do
-  OPENBLAS_NUM_THREADS=1 "$B/bench_wet" "$N" 10 "$BETA" 1000 500 "$SCHEME" "$s" "$MARGIN" "$ROUNDIT" "$WARM" "$LDL"
+  OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} OPENBLAS_NUM_THREADS=1 "$B/bench_wet" "$N" 10 "$BETA" 1000 500 "$SCHEME" "$s" "$MARGIN" "$ROUNDIT" "$WARM" "$LDL"
 done | tee "${OUT:-/dev/null}" | /usr/bin/python3 "$(dirname "$0")/summarize_wet_seeds.py"

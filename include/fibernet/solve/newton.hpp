@@ -11,8 +11,8 @@
 //                              not factor, the shift on the exact H is raised 4x at a time up to 0.2 mean diag;
 //      With SolverOptions::ldl, rung 0 is instead a simplicial LDL^T of H + mu I with its negative pivots replaced by
 //      their magnitudes (cholmod_ldl.hpp): negative curvature is handled where it occurs, with no shift for the rest
-//      of the Hessian (the wet relaxations of large networks, docs/solvers.md); the escalation follows only if that
-//      fails (a zero pivot, or no descent direction);
+//      of the Hessian (the wet relaxations of large networks, docs/wet.md); the escalation follows if that fails (a
+//      zero pivot, no descent direction, or a line search that finds no step: then in the same iteration);
 //   1. per-element PSD-projected H + mu I  (buckled or compressed segments make H indefinite);
 //   2. projected H + lambda I, lambda = 1e-8 * mean diag(H) * 10^j, j = 0..10;
 //   3. steepest descent d = -g.
