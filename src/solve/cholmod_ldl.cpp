@@ -73,6 +73,7 @@ void CholmodLDL::analyze(const Eigen::SparseMatrix<double>& upper) {
 }
 
 bool CholmodLDL::factorize(const Eigen::SparseMatrix<double>& upper, double shift) {
+    // A matrix of another size is analyzed first; one of the same size is taken to have the analyzed pattern.
     if (!impl_->L || impl_->L->n != static_cast<size_t>(upper.rows())) analyze(upper);
     cholmod_sparse A = view(upper);
     double beta[2] = {shift, 0.0};

@@ -187,10 +187,11 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         // flipped-curvature direction), the second redoes the iteration with the shifted LL^T ladder.
         int rung = -1;
         double shift = 0, alpha = 1, ft = 0;
-        bool accepted = false, retry = false;
+        bool accepted = false, retry = false, retried = false, step_ldl = false;
         for (int pass = 0; pass < 2 && !accepted; ++pass) {
             if (pass == 1 && !retry) break;
-            bool used_ldl = false;
+            retried = pass == 1;
+            bool used_ldl = false, indefinite = false;
             rung = -1, shift = 0;
             if (start_rung <= 0 && ldl && pass == 0) {
                 // Rung 0 by LDL^T (SolverOptions::ldl): the exact H + mu I with its negative pivots flipped, a positive
@@ -205,11 +206,17 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
                     auto ts = Clock::now();
                     d = -ldl->solve_modified(g, mu);
                     r.timings.solve += since(ts);
-                    if (d.allFinite() && g.dot(d) < -kDescent * gnorm * d.norm()) rung = 0, shift = mu, used_ldl = true;
+                    if (d.allFinite() && g.dot(d) < -kDescent * gnorm * d.norm()) {
+                        rung = 0, shift = mu, used_ldl = true;
+                        // No negative pivot: H + mu I is positive definite (Sylvester's law of inertia) and this is the
+                        // LL^T direction itself, so a failed line search has nothing to retry.
+                        indefinite = ldl->negative_pivots() > 0;
+                    }
                 }
             }
             if (start_rung <= 0 && rung < 0) {  // H holds the exact Hessian (assembled with projected = start_rung >= 1)
-                if (try_factor(mu)) {
+                // (On the retry H + mu I is known to be indefinite: the escalation starts above mu.)
+                if (pass == 0 && try_factor(mu)) {
                     rung = 0, shift = mu;
                 } else {
                     // Exact H + lambda I with lambda raised 4x at a time (Nocedal & Wright, Alg. 3.3) before giving up
@@ -237,7 +244,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
             auto tl = Clock::now();
             for (int attempt = 0; attempt < 2 && !accepted; ++attempt) {
                 if (attempt == 1) {  // the Newton-type direction failed: one steepest-descent try (after the LDL^T retry)
-                    if (rung == 3 || used_ldl) break;
+                    if (rung == 3 || (used_ldl && indefinite)) break;
                     rung = 3, d = -g / dm;
                 }
                 const double gd = g.dot(d);
@@ -263,13 +270,16 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
                 }
             }
             r.timings.line_search += since(tl);
-            retry = !accepted && used_ldl;
+            step_ldl = accepted && used_ldl;
+            retry = !accepted && used_ldl && indefinite;
+            if (retry) ++r.ldl_retries;
         }
         rungs_.push_back(rung);
         shifts_.push_back(rung <= 2 ? shift : 0.0);
         if (opt_.verbose)
-            std::fprintf(stderr, "newton %4d  E = %.15e  max|g| = %.3e  floor %.1e  rung %d  shift %.2e  alpha %.3e\n", it, fq,
-                         gmax, floor, rung, shift, accepted ? alpha : 0.0);
+            std::fprintf(stderr, "newton %4d  E = %.15e  max|g| = %.3e  floor %.1e  rung %d%s  shift %.2e  alpha %.3e\n", it,
+                         fq, gmax, floor, rung, step_ldl ? " (LDL^T)" : retried ? " (after LDL^T)" : "", shift,
+                         accepted ? alpha : 0.0);
         if (!accepted) {
             r.status = SolveStatus::LineSearchFailed;
             r.message = "no acceptable step along a descent direction at iteration " + std::to_string(it);
@@ -286,6 +296,9 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
             if (alpha == 1 && rho > 0.5) mu_lm = std::max(kMuFloor * dm, shift / 10);
             else if (alpha < 1 || rho < 0.25) mu_lm = std::max(4 * shift, kMuFloor * dm);
             else mu_lm = shift;
+            // After a retry the ladder's escalated shift damps the whole Hessian; the next LDL^T iteration grows from
+            // its own shift instead, as after a backtracked step.
+            if (retried) mu_lm = std::max(4 * mu, kMuFloor * dm);
         }
         q = qt;
         start_rung = std::max(0, std::min(rung, 2) - 1);

@@ -14,7 +14,7 @@ std::atomic<int> override_count{0};
 }
 
 void set_thread_count(int n) {
-    if (n < 1) throw std::invalid_argument("set_thread_count: n = " + std::to_string(n) + " must be >= 1");
+    if (n < 0) throw std::invalid_argument("set_thread_count: n = " + std::to_string(n) + " must be >= 0");
     override_count = n;
 }
 

@@ -84,9 +84,11 @@ double WetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::Spar
     const Eigen::Matrix2d B = F_ * dry_.model().box.B0();
     // Elements in chunks: each chunk's elements are evaluated in parallel into their own slots, then added in element
     // order, so the sums (and every solve) are bit for bit the same for any thread count.
+    // Chunks bound the Hessian blocks' buffer (2 KB per element); without a Hessian one chunk holds every element.
+    // Threads get at least kParallelMin / 2 elements each (a thread start costs about as much as 20 elements).
     const size_t ne = elements_.size();
-    const size_t chunk = std::min(ne, kChunk);
-    const int threads = ne >= kParallelMin ? thread_count() : 1;
+    const size_t chunk = H ? std::min(ne, kChunk) : ne;
+    const int threads = static_cast<int>(std::min<size_t>(thread_count(), std::max<size_t>(1, 2 * ne / kParallelMin)));
     chunk_E_.resize(chunk);
     if (g) chunk_g_.resize(chunk);
     if (H) chunk_H_.resize(chunk);

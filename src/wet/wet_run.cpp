@@ -203,14 +203,17 @@ public:
                 SolveResult sr = solver_.minimize(W, qq[k]);
                 ++R_.stiffness_solves, R_.solver_iterations += sr.iterations;
                 SolverOptions& so = solver_.options();
-                if (!sr.converged() && !so.ldl && as_.newton_ldl && params_.beta > 0) {
+                if (sr.status == SolveStatus::LineSearchFailed && !so.ldl && as_.newton_ldl && params_.beta > 0) {
                     // Retried from the same start with Newton's LDL^T rung (as the relaxations use): on one free-box
                     // seed of docs/wet.md the shifted ladder's line search failed here and the retry converged.
+                    struct Restore {
+                        SolverOptions& so;
+                        ~Restore() { so.ldl = false; }
+                    } restore{so};
                     qq[k] = dry_.affine_map(S.q, S.F, Fj);
                     so.ldl = true;
                     sr = solver_.minimize(W, qq[k]);
-                    so.ldl = false;
-                    ++R_.stiffness_solves, ++R_.stiffness_retries, R_.solver_iterations += sr.iterations;
+                    ++R_.stiffness_retries, R_.solver_iterations += sr.iterations;
                 }
                 if (!sr.converged()) {
                     R_.message = "iteration " + std::to_string(iter) + ": a stiffness relaxation failed (" +

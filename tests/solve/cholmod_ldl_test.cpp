@@ -2,7 +2,7 @@
 // replaced by max(|D_j|, floor).
 #include <catch2/catch.hpp>
 
-#include <Eigen/SparseCholesky>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <vector>
 
@@ -94,4 +94,34 @@ TEST_CASE("cholmod_ldl: a zero pivot fails the factorization", "[cholmod_ldl]") 
     CHECK_FALSE(ldl.factorize(upper(A), 0.0));
     CHECK_THROWS(ldl.solve_modified(Eigen::Vector2d(1, 0), 1.0));
     CHECK(ldl.factorize(upper(A), 1e-3));  // shifted: positive definite
+}
+
+TEST_CASE("cholmod_ldl: inertia and descent on a sparse indefinite matrix", "[cholmod_ldl]") {
+    // A 2D grid Laplacian-like matrix with some negative diagonal entries: a fill-reducing permutation that is not the
+    // identity, and coupled negative curvature. The number of negative pivots is the number of negative eigenvalues
+    // (Sylvester's law of inertia), and the modified solve is a positive definite operator (x.b > 0).
+    const int m = 8, n = m * m;
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+    for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) {
+            const int k = i * m + j;
+            A(k, k) = 4.2 - ((i * 7 + j * 3) % 11 == 0 ? 6.0 : 0.0);
+            if (j + 1 < m) A(k, k + 1) = A(k + 1, k) = -1;
+            if (i + 1 < m) A(k, k + m) = A(k + m, k) = -1;
+        }
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(A);
+    int negative = 0;
+    for (int i = 0; i < n; ++i) negative += es.eigenvalues()[i] < 0;
+    REQUIRE(negative > 0);
+    REQUIRE(es.eigenvalues().cwiseAbs().minCoeff() > 1e-6);
+    CholmodLDL ldl;
+    REQUIRE(ldl.factorize(upper(A), 0.0));
+    CHECK(ldl.negative_pivots() == negative);
+    for (int t = 0; t < 10; ++t) {
+        Eigen::VectorXd b(n);
+        for (int i = 0; i < n; ++i) b[i] = std::sin(0.37 * i * (t + 1) + t);
+        const Eigen::VectorXd x = ldl.solve_modified(b, 1e-12);
+        CHECK(x.allFinite());
+        CHECK(x.dot(b) > 0);
+    }
 }

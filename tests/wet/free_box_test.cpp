@@ -246,7 +246,7 @@ TEST_CASE("free box: a failed stiffness relaxation is retried with Newton's LDL^
         // LDL^T in every stiffness solve, the path then meets a snap: a reported outcome, not a failed solve).
         CHECK(f.iterations >= 1);
         CHECK(f.stiffness_retries > 0);
-        CHECK(f.stiffness_retries * 2 == f.stiffness_solves);
+        CHECK(f.stiffness_retries == f.stiffness_solves);
         CHECK(f.message.find("stiffness relaxation failed") == std::string::npos);
     }
 }

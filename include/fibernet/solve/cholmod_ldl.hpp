@@ -4,6 +4,9 @@
 // max(|D_j|, floor): a positive definite L |D| L^T that agrees with H + shift I wherever its pivots are positive.
 // Newton's first rung (newton.hpp): negative curvature is handled where it occurs, instead of by one shift of the
 // whole Hessian, so that a buckling spot does not shorten the step of every other part of a large network.
+// Without pivoting, a near-zero pivot can make entries of L large (the floor bounds only D): Newton checks that the
+// direction is finite and one of descent, and falls back to its shifted LL^T ladder when it is not or when its line
+// search fails.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>

@@ -30,6 +30,7 @@ struct SolveResult {
     std::string message;                // detail from the backend or the ladder
     int iterations = 0;
     int factorizations = 0;
+    int ldl_retries = 0;                // Newton: iterations whose LDL^T direction failed its line search (SolverOptions::ldl)
     int evaluations = 0;                // energy/gradient evaluations
     double energy = 0;
     double grad_max = 0;                // max |g| at the returned state

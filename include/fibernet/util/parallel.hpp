@@ -10,8 +10,8 @@ namespace fibernet {
 
 // Threads for element loops: the environment variable FIBERNET_THREADS if set (>= 1), else the hardware's count.
 int thread_count();
-// Overrides that count from here on (n >= 1; tests compare thread counts); thread_count_default() is the count
-// without an override.
+// Overrides that count from here on (n >= 1; n = 0 removes the override; tests compare thread counts);
+// thread_count_default() is the count without an override.
 void set_thread_count(int n);
 int thread_count_default();
 
@@ -34,7 +34,12 @@ void parallel_ranges(std::size_t n, int threads, Body body) {
     };
     std::vector<std::thread> pool;
     pool.reserve(t - 1);
-    for (std::size_t k = 1; k < t; ++k) pool.emplace_back(run, k);
+    try {
+        for (std::size_t k = 1; k < t; ++k) pool.emplace_back(run, k);
+    } catch (...) {  // a thread could not be started: finish the started ones before giving up
+        for (auto& th : pool) th.join();
+        throw;
+    }
     run(0);
     for (auto& th : pool) th.join();
     for (auto& e : errors)

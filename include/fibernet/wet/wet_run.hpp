@@ -74,7 +74,8 @@ struct FreeBoxResult {
     // Empty if not computed.
     Eigen::VectorXd stiffness_eigenvalues;
     int iterations = 0, relaxations = 0, stiffness_solves = 0, solver_iterations = 0;
-    int stiffness_retries = 0;  // stiffness solves retried with Newton's LDL^T rung after the shifted ladder failed
+    int stiffness_retries = 0;  // stiffness solves retried with Newton's LDL^T rung after the shifted ladder's line
+                                // search failed (not counted in stiffness_solves)
     std::vector<FreeBoxIteration> history;  // the start and every iteration's new point
     bool bracketed = false;       // isotropic: a point past zero stress was met (the search bracketed the root)
     bool snap = false;            // isotropic: the mean stress jumps across zero between snap_s[0] and snap_s[1]
