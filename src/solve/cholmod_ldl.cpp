@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "cholmod_view.hpp"
+
 namespace fibernet {
 
 struct CholmodLDL::Impl {
@@ -31,22 +33,7 @@ struct CholmodLDL::Impl {
 };
 
 namespace {
-cholmod_sparse view(const Eigen::SparseMatrix<double>& A) {
-    if (!A.isCompressed()) throw std::logic_error("CholmodLDL: matrix must be compressed");
-    cholmod_sparse s{};
-    s.nrow = s.ncol = static_cast<size_t>(A.rows());
-    s.nzmax = static_cast<size_t>(A.nonZeros());
-    s.p = const_cast<int*>(A.outerIndexPtr());
-    s.i = const_cast<int*>(A.innerIndexPtr());
-    s.x = const_cast<double*>(A.valuePtr());
-    s.stype = 1;
-    s.itype = CHOLMOD_INT;
-    s.xtype = CHOLMOD_REAL;
-    s.dtype = CHOLMOD_DOUBLE;
-    s.sorted = 1;
-    s.packed = 1;
-    return s;
-}
+cholmod_sparse view(const Eigen::SparseMatrix<double>& A) { return detail::cholmod_upper_view(A, "CholmodLDL"); }
 
 cholmod_dense dense_view(Eigen::VectorXd& v) {
     cholmod_dense d{};

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "cholmod_view.hpp"
+
 namespace fibernet {
 
 struct CholmodLLT::Impl {
@@ -28,23 +30,7 @@ struct CholmodLLT::Impl {
 };
 
 namespace {
-// A cholmod_sparse view (no copy) of an upper-triangular Eigen CSC matrix with int indices.
-cholmod_sparse view(const Eigen::SparseMatrix<double>& A) {
-    if (!A.isCompressed()) throw std::logic_error("CholmodLLT: matrix must be compressed");
-    cholmod_sparse s{};
-    s.nrow = s.ncol = static_cast<size_t>(A.rows());
-    s.nzmax = static_cast<size_t>(A.nonZeros());
-    s.p = const_cast<int*>(A.outerIndexPtr());
-    s.i = const_cast<int*>(A.innerIndexPtr());
-    s.x = const_cast<double*>(A.valuePtr());
-    s.stype = 1;  // upper triangle stored
-    s.itype = CHOLMOD_INT;
-    s.xtype = CHOLMOD_REAL;
-    s.dtype = CHOLMOD_DOUBLE;
-    s.sorted = 1;
-    s.packed = 1;
-    return s;
-}
+cholmod_sparse view(const Eigen::SparseMatrix<double>& A) { return detail::cholmod_upper_view(A, "CholmodLLT"); }
 }  // namespace
 
 CholmodLLT::CholmodLLT() : impl_(std::make_unique<Impl>()) {}

@@ -164,6 +164,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         dm_last = dm;
         const double mu = std::max(kMuFloor * dm, mu_lm);
         const double gnorm = g.norm();
+        auto descent = [&] { return d.allFinite() && g.dot(d) < -kDescent * gnorm * d.norm(); };
         auto try_factor = [&](double s) {
             auto tf = Clock::now();
             const bool ok = llt.factorize(H, s);
@@ -173,7 +174,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
             auto ts = Clock::now();
             d = llt.solve(-g);
             r.timings.solve += since(ts);
-            return d.allFinite() && g.dot(d) < -kDescent * gnorm * d.norm();
+            return descent();
         };
         auto make_projected = [&] {
             if (projected) return;
@@ -206,7 +207,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
                     auto ts = Clock::now();
                     d = -ldl->solve_modified(g, mu);
                     r.timings.solve += since(ts);
-                    if (d.allFinite() && g.dot(d) < -kDescent * gnorm * d.norm()) {
+                    if (descent()) {
                         rung = 0, shift = mu, used_ldl = true;
                         // No negative pivot: H + mu I is positive definite (Sylvester's law of inertia) and this is the
                         // LL^T direction itself, so a failed line search has nothing to retry.
