@@ -2,7 +2,8 @@
 // scheme) relaxed dry, wetted at all crossings and relaxed under capillary load with mobile bridges.
 // Prints one JSON line per run with the time split: dry Newton, wet Newton, event handling, pore analysis.
 //   bench_wet [N=1000] [q=10] [beta=0.01] [max_rounds=1000] [newton_max_iter=500] [scheme=seed] [seed=1] [move_margin=0.1]
-//             [round_iterations=10] [warm_start=1] [newton_ldl=1]
+//             [round_iterations=10] [warm_start=1] [newton_ldl=1] [local_fraction=0.25] [local_threshold=1e-2]
+//             [local_hops=3]
 // The "newton" block sums the wet solves' time split over all rounds.
 // Environment: BENCH_VERBOSE=1 prints a line per active-set round, BENCH_NEWTON_VERBOSE=1 a line per Newton iteration.
 #include <chrono>
@@ -29,6 +30,9 @@ int main(int argc, char** argv) {
     const int round_iterations = argc > 9 ? std::atoi(argv[9]) : ActiveSetOptions{}.round_iterations;
     const bool warm_start = argc > 10 ? std::atoi(argv[10]) != 0 : ActiveSetOptions{}.warm_start;
     const bool newton_ldl = argc > 11 ? std::atoi(argv[11]) != 0 : ActiveSetOptions{}.newton_ldl;
+    const double local_fraction = argc > 12 ? std::atof(argv[12]) : ActiveSetOptions{}.local_fraction;
+    const double local_threshold = argc > 13 ? std::atof(argv[13]) : ActiveSetOptions{}.local_threshold;
+    const int local_hops = argc > 14 ? std::atoi(argv[14]) : ActiveSetOptions{}.local_hops;
     const auto t0 = std::chrono::steady_clock::now();
     MikadoParams mp;
     mp.q = q, mp.pl = 0.5, mp.seed = seed;
@@ -46,6 +50,9 @@ int main(int argc, char** argv) {
     opt.active_set.round_iterations = round_iterations;
     opt.active_set.warm_start = warm_start;
     opt.active_set.newton_ldl = newton_ldl;
+    opt.active_set.local_fraction = local_fraction;
+    opt.active_set.local_threshold = local_threshold;
+    opt.active_set.local_hops = local_hops;
     opt.active_set.verbose = std::getenv("BENCH_VERBOSE") != nullptr;  // a line per active-set round on stderr
     opt.solver_options.tol = 1e-8;
     opt.solver_options.max_iter = max_iter;
@@ -54,13 +61,13 @@ int main(int argc, char** argv) {
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf(
         "{\"fibers\": %zu, \"q\": %g, \"beta\": %g, \"nodes\": %d, \"bridges_initial\": %zu, \"bridges_final\": %zu, "
-        "\"rounds\": %d, \"E_total\": %.10g, \"E_capillary\": %.10g, \"stable\": %s, \"cycling\": %s, \"cycles_broken\": %d, \"newton_iterations\": %d, \"events\": %d, "
-        "\"seconds\": {\"build\": %.3f, \"dry\": %.3f, \"wet_newton\": %.3f, \"events\": %.3f, \"pores\": %.3f, "
+        "\"rounds\": %d, \"local_rounds\": %d, \"local_iterations\": %d, \"E_total\": %.10g, \"E_capillary\": %.10g, \"stable\": %s, \"cycling\": %s, \"cycles_broken\": %d, \"newton_iterations\": %d, \"events\": %d, "
+        "\"seconds\": {\"build\": %.3f, \"dry\": %.3f, \"wet_newton\": %.3f, \"wet_local\": %.3f, \"events\": %.3f, \"pores\": %.3f, "
         "\"total\": %.3f}, \"newton\": {\"factorizations\": %d, \"assembly\": %.3f, "
         "\"factorization\": %.3f, \"solve\": %.3f, \"line_search\": %.3f, \"total\": %.3f}, \"message\": \"%s\"}\n",
-        net.fibers.size(), q, beta, m.num_nodes(), r.initial_bridges.size(), r.active.bridges.size(), r.active.rounds, r.wet.energy.total(), r.wet.energy.capillary,
+        net.fibers.size(), q, beta, m.num_nodes(), r.initial_bridges.size(), r.active.bridges.size(), r.active.rounds, r.active.local_rounds, r.active.local_iterations, r.wet.energy.total(), r.wet.energy.capillary,
         r.active.stable ? "true" : "false", r.active.cycling ? "true" : "false", r.active.cycles_broken, r.active.solver_iterations,
-        r.active.events.total(), t_build, r.seconds_dry, r.seconds_wet_solve, r.seconds_events, r.seconds_pores, total,
+        r.active.events.total(), t_build, r.seconds_dry, r.seconds_wet_solve, r.active.seconds_local, r.seconds_events, r.seconds_pores, total,
         r.active.factorizations, r.active.timings.assembly, r.active.timings.factorization, r.active.timings.solve,
         r.active.timings.line_search, r.active.timings.total, r.active.message.c_str());
     return 0;

@@ -166,6 +166,9 @@ void register_wet(CLI::App& app) {
         opt.active_set.max_rounds = s.wet.max_rounds;
         opt.active_set.round_iterations = s.wet.round_iterations;
         opt.active_set.newton_ldl = s.wet.newton_ldl;
+        opt.active_set.local_fraction = s.wet.local_fraction;
+        opt.active_set.local_threshold = s.wet.local_threshold;
+        opt.active_set.local_hops = s.wet.local_hops;
         if (w->verbose && w->quiet) throw InputError("--verbose and --quiet contradict each other");
         opt.moduli = !w->no_moduli;
         make_solver(opt.solver, opt.solver_options);  // an unknown solver is an InputError before any work

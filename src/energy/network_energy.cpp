@@ -138,16 +138,62 @@ Eigen::VectorXd NetworkEnergy::affine_map(const Eigen::VectorXd& q, const Eigen:
     return dofs(x);
 }
 
-void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F, const Eigen::Matrix2d& dF,
-                             unsigned want, EnergyEval& out, Eigen::SparseMatrix<double>* H) const {
-    const bool wg = want & kGradient, wh = want & kHessian, ws = want & kStrain, psd = want & kProjectPSD;
-    // Node displacements u = x - x_ref: q for free nodes, (F - I) x_ref for fixed ones.
+Eigen::VectorXd NetworkEnergy::displacements(const Eigen::VectorXd& q, const Eigen::Matrix2d& F) const {
+    // u = x - x_ref: q for free nodes, (F - I) x_ref for fixed ones.
     Eigen::VectorXd u(dof_.size());
     const Eigen::Matrix2d FmI = F - Eigen::Matrix2d::Identity();
     for (int i = 0; i < model_.num_nodes(); ++i) {
         if (dof_[2 * i] >= 0) u[2 * i] = q[dof_[2 * i]], u[2 * i + 1] = q[dof_[2 * i + 1]];
         else u.segment<2>(2 * i) = FmI * model_.x.segment<2>(2 * i);
     }
+    return u;
+}
+
+double NetworkEnergy::segment_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F, Eigen::Vector4d* g,
+                                   Eigen::Matrix4d* H, bool psd) const {
+    const Segment& s = model_.segments[e];
+    const Eigen::Matrix2d FmIB0 = (F - Eigen::Matrix2d::Identity()) * model_.box.B0();
+    const Eigen::Vector2d d = seg_d0_[e] + FmIB0 * s.shift.cast<double>() + (u.segment<2>(2 * s.j) - u.segment<2>(2 * s.i));
+    Eigen::Vector2d gd;
+    Eigen::Matrix2d Hd;
+    const double E = stretch_energy(d, s.l0, 4 * model_.aspect_ratio * model_.aspect_ratio, params_.stretch,
+                                    g ? &gd : nullptr, H ? &Hd : nullptr);
+    if (g) *g << -gd, gd;
+    if (H) {
+        const Eigen::Matrix2d h = psd ? project_psd<2>(Hd) : Hd;
+        *H << h, -h, -h, h;
+    }
+    return E;
+}
+
+double NetworkEnergy::hinge_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F,
+                                 Eigen::Matrix<double, 6, 1>* g, Eigen::Matrix<double, 6, 6>* H, bool psd) const {
+    const Hinge& h = model_.hinges[e];
+    const Eigen::Matrix2d FmIB0 = (F - Eigen::Matrix2d::Identity()) * model_.box.B0();
+    const Eigen::Vector2d d1 = hinge_d0_[2 * e] + FmIB0 * h.shift1.cast<double>() + (u.segment<2>(2 * h.j) - u.segment<2>(2 * h.i));
+    const Eigen::Vector2d d2 = hinge_d0_[2 * e + 1] + FmIB0 * h.shift2.cast<double>() + (u.segment<2>(2 * h.k) - u.segment<2>(2 * h.j));
+    Eigen::Vector4d g4;
+    Eigen::Matrix4d H4;
+    const double E = bend_energy(d1, d2, h.lt0, g ? &g4 : nullptr, H ? &H4 : nullptr);
+    // d1 = x_j - x_i, d2 = x_k - x_j (+ images).
+    if (g) *g << -g4.head<2>(), g4.head<2>() - g4.tail<2>(), g4.tail<2>();
+    if (H) {
+        Eigen::Matrix<double, 4, 6> A = Eigen::Matrix<double, 4, 6>::Zero();
+        A.block<2, 2>(0, 0) = -Eigen::Matrix2d::Identity();
+        A.block<2, 2>(0, 2) = Eigen::Matrix2d::Identity();
+        A.block<2, 2>(2, 2) = -Eigen::Matrix2d::Identity();
+        A.block<2, 2>(2, 4) = Eigen::Matrix2d::Identity();
+        const Eigen::Matrix4d hp = psd ? project_psd<4>(H4) : H4;
+        *H = A.transpose() * hp * A;
+    }
+    return E;
+}
+
+void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F, const Eigen::Matrix2d& dF,
+                             unsigned want, EnergyEval& out, Eigen::SparseMatrix<double>* H) const {
+    const bool wg = want & kGradient, wh = want & kHessian, ws = want & kStrain, psd = want & kProjectPSD;
+    const Eigen::VectorXd u = displacements(q, F);
+    const Eigen::Matrix2d FmI = F - Eigen::Matrix2d::Identity();
     const Eigen::Matrix2d dB = dF * model_.box.B0(), FmIB0 = FmI * model_.box.B0();
     const double k4a2 = 4 * model_.aspect_ratio * model_.aspect_ratio;
     const bool any_fixed = ndof_ != static_cast<int>(dof_.size());

@@ -24,6 +24,11 @@ void Scene::check() const {
     check_value(wet.free_box_tol > 0, wet.free_box_tol, source, "[wet].free_box_tol", "must be > 0");
     check_value(wet.max_rounds >= 1, wet.max_rounds, source, "[wet].max_rounds", "must be >= 1");
     check_value(wet.round_iterations >= 0, wet.round_iterations, source, "[wet].round_iterations", "must be >= 0");
+    check_value(wet.local_fraction >= 0 && wet.local_fraction <= 1, wet.local_fraction, source, "[wet].local_fraction",
+                "must lie in [0, 1]");
+    check_value(wet.local_threshold > 0 && wet.local_threshold < 1, wet.local_threshold, source, "[wet].local_threshold",
+                "must lie in (0, 1)");
+    check_value(wet.local_hops >= 0, wet.local_hops, source, "[wet].local_hops", "must be >= 0");
     if (wet.free_box_shape != "full" && wet.free_box_shape != "isotropic")
         throw InputError(source + ": [wet].free_box_shape = '" + wet.free_box_shape +
                          "' is unknown (expected isotropic or full)");
@@ -178,6 +183,9 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         r.get("max_rounds", s.wet.max_rounds);
         r.get("round_iterations", s.wet.round_iterations);
         r.get("newton_ldl", s.wet.newton_ldl);
+        r.get("local_fraction", s.wet.local_fraction);
+        r.get("local_threshold", s.wet.local_threshold);
+        r.get("local_hops", s.wet.local_hops);
         r.finish();
     }
     s.check();

@@ -13,9 +13,17 @@ WetEnergy::WetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, std::ve
     const Model& m = dry.model();
     elements_.reserve(bridges_.size());
     for (const Bridge& b : bridges_) elements_.push_back(resolve(m, b));
+}
+
+// The Hessian pattern and slots on first use: a round that only needs the gradient, or solves a region
+// (wet_region.hpp), never builds them.
+const Eigen::SparseMatrix<double>& WetEnergy::hessian_pattern() const {
+    if (pattern_built_) return pattern_;
+    pattern_built_ = true;
+    const NetworkEnergy& dry = dry_;
     if (!active()) {
         pattern_ = dry.hessian_pattern();
-        return;
+        return pattern_;
     }
     // Union pattern, column by column.
     const Eigen::SparseMatrix<double>& P = dry.hessian_pattern();
@@ -60,10 +68,12 @@ WetEnergy::WetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, std::ve
                 if (r >= 0 && c >= 0 && r <= c) bridge_slots_[256 * k + 16 * a + b] = slot(r, c);
             }
     dry_H_ = P;
+    return pattern_;
 }
 
 double WetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) {
     const unsigned want = (g ? kGradient : 0u) | (H ? kHessian : 0u) | (psd ? kProjectPSD : 0u);
+    if (H) hessian_pattern();
     if (!active()) {  // the dry energy itself: bit for bit
         dry_.evaluate(q, F_, Eigen::Matrix2d::Zero(), want, eval_, H);
         if (g) g->swap(eval_.gradient);
@@ -74,7 +84,7 @@ double WetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::Spar
     if (g) g->swap(eval_.gradient);
     double* hv = nullptr;
     if (H) {
-        if (H->nonZeros() != pattern_.nonZeros()) throw std::logic_error("Hessian lacks the wet energy's pattern");
+        if (H->nonZeros() != hessian_pattern().nonZeros()) throw std::logic_error("Hessian lacks the wet energy's pattern");
         hv = H->valuePtr();
         std::fill(hv, hv + H->nonZeros(), 0.0);
         const double* dv = dry_H_.valuePtr();

@@ -80,6 +80,7 @@ TEST_CASE("wet relaxation: rounds are capped while the bridge set changes, then 
         Recording s(so);
         ActiveSetOptions opt;
         opt.round_iterations = cap;
+        opt.local_fraction = 0;  // one solve of the whole network per round (local rounds: wet_region_test.cpp)
         Eigen::VectorXd q = e.dofs(m.x);
         const ActiveSetResult r = relax_wet(e, Eigen::Matrix2d::Identity(), p, initial, s, q, opt);
         INFO("cap " << cap << ": " << r.message << ", rounds " << r.rounds);

@@ -3,6 +3,7 @@
 #include <fstream>
 
 #include "fibernet/scene/scene.hpp"
+#include "fibernet/wet/active_set.hpp"
 #include "fibernet/util/error.hpp"
 
 using namespace fibernet;
@@ -26,6 +27,13 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
     CHECK(parse_scene("", "empty.toml").wet.round_iterations == 10);
     CHECK(parse_scene("", "empty.toml").wet.newton_ldl);
     CHECK(!parse_scene("[wet]\nnewton_ldl = false\n", "l.toml").wet.newton_ldl);
+    const Scene loc = parse_scene("[wet]\nlocal_fraction = 0\nlocal_threshold = 0.001\nlocal_hops = 5\n", "loc.toml");
+    CHECK(loc.wet.local_fraction == 0);
+    CHECK(loc.wet.local_threshold == 0.001);
+    CHECK(loc.wet.local_hops == 5);
+    CHECK(parse_scene("", "empty.toml").wet.local_fraction == ActiveSetOptions{}.local_fraction);
+    CHECK(parse_scene("", "empty.toml").wet.local_threshold == ActiveSetOptions{}.local_threshold);
+    CHECK(parse_scene("", "empty.toml").wet.local_hops == ActiveSetOptions{}.local_hops);
     struct Bad {
         std::string toml, needle;
     };
@@ -40,6 +48,10 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
                          Bad{"[wet]\nround_iterations = -1\n", "[wet].round_iterations = -1"},
                          Bad{"[wet]\nround_iterations = 2.5\n", "[wet].round_iterations"},
                          Bad{"[wet]\nnewton_ldl = 1\n", "[wet].newton_ldl"},
+                         Bad{"[wet]\nlocal_fraction = 1.5\n", "[wet].local_fraction = 1.5"},
+                         Bad{"[wet]\nlocal_fraction = nan\n", "[wet].local_fraction = nan"},
+                         Bad{"[wet]\nlocal_threshold = 0\n", "[wet].local_threshold = 0"},
+                         Bad{"[wet]\nlocal_hops = -1\n", "[wet].local_hops = -1"},
                          Bad{"[wet]\nlaw = \"/nonexistent/law.txt\"\n", "/nonexistent/law.txt"}}) {
         INFO(b.toml);
         try {

@@ -60,6 +60,15 @@ public:
 
     const Eigen::SparseMatrix<double>& hessian_pattern() const { return pattern_; }
 
+    // One element at a time, for a caller that assembles part of the network (wet/wet_region.hpp). u: every node's
+    // displacement from displacements(q, F) (fixed nodes at (F - I) x_ref). Local coordinates are the element's
+    // nodes' (x, y) in order: segment (i, j), hinge (i, j, k). Same terms as evaluate().
+    Eigen::VectorXd displacements(const Eigen::VectorXd& q, const Eigen::Matrix2d& F) const;
+    double segment_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F, Eigen::Vector4d* g,
+                        Eigen::Matrix4d* H, bool project_psd) const;
+    double hinge_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F, Eigen::Matrix<double, 6, 1>* g,
+                      Eigen::Matrix<double, 6, 6>* H, bool project_psd) const;
+
 private:
     const Model& model_;
     EnergyParams params_;

@@ -32,6 +32,11 @@ struct WetSettings {
     int max_rounds = 1000;      // active-set rounds (bridge-set updates) per relaxation, >= 1
     int round_iterations = 10;  // Newton iterations per round while the set changes (0: solve each round to the end)
     bool newton_ldl = true;     // Newton's first rung by LDL^T with flipped negative pivots (docs/wet.md)
+    // Local rounds (docs/wet.md, "Local rounds"): the part of the network that needs a solve, if it holds at most
+    // local_fraction of the coordinates (0: every round global); hot: |g| > local_threshold x max|g|, grown by local_hops.
+    double local_fraction = 0.25;
+    double local_threshold = 1e-2;
+    int local_hops = 3;
 };
 
 struct Scene {

@@ -53,6 +53,12 @@ struct ActiveSetOptions {
     // is indefinite somewhere at almost every iteration, and the escalated shift that the whole Hessian otherwise
     // gets shortens every other part's step (docs/wet.md, "Newton on wet networks"). Other solvers ignore it.
     bool newton_ldl = true;
+    // Local rounds (wet_region.hpp): after a round, the nodes with a coordinate |g| > local_threshold x max|g| (and
+    // > the solver's tol), grown by local_hops elements, form the next round's region, solved with the rest held, if
+    // it holds at most local_fraction of the coordinates; otherwise the round is global. 0: every round global.
+    double local_fraction = 0.25;
+    double local_threshold = 1e-2;
+    int local_hops = 3;
     bool form_new = true;        // give new crossings and new contacts bridges
     double contact_distance = 0;  // seed units; 0: the fiber diameter 2 r = 2 ls / a
     double contact_angle_deg = 10;
@@ -67,6 +73,9 @@ struct ActiveSetResult {
     WetEvents events;              // summed over rounds
     std::vector<WetEvents> per_round;
     int rounds = 0, solver_iterations = 0, factorizations = 0;
+    int local_rounds = 0;          // rounds solved on a region of the network (ActiveSetOptions::local_fraction)
+    int local_iterations = 0;      // solver iterations in those rounds, summed over their parts
+    double seconds_local = 0;      // solve time in those rounds (part of seconds_solve)
     SolveTimings timings;          // the solver's time split, summed over rounds
     bool stable = false;           // the last round changed nothing: q is an equilibrium with a consistent set
     bool cycling = false;          // a bridge set repeated after max_freezes cycles were broken
@@ -82,15 +91,19 @@ using FiberPairs = std::set<std::pair<int, int>>;
 // Updates `bridges` (moves, ruptures, merges; new bridges if form_new) at state q of `dry` at F; returns the counts.
 // Bridges between `frozen` fiber pairs are kept unchanged and such pairs get no new bridges. settled: q is an
 // equilibrium of the current set; only then does a nearly parallel (unlocked) pair out of contact rupture.
+// moved (one flag per node, may be null): only these nodes moved since the last update (a local round), so bridges
+// with none of them are kept as they are and only segments with one can form new bridges.
 WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
                          std::vector<Bridge>& bridges, const ActiveSetOptions& opt = {},
-                         const FiberPairs* frozen = nullptr, bool settled = true);
+                         const FiberPairs* frozen = nullptr, bool settled = true, const std::vector<char>* moved = nullptr);
 
 // All intersecting segment pairs of different fibers that share no node, as bridges (nearest periodic image).
-std::vector<Bridge> segment_crossings(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B);
+// only (one flag per segment, may be null): pairs with at least one flagged segment.
+std::vector<Bridge> segment_crossings(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+                                      const std::vector<char>* only = nullptr);
 // All segment pairs of different fibers in contact (see "zip" above), as locked bridges.
 std::vector<Bridge> segment_contacts(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double distance,
-                                     double angle_deg);
+                                     double angle_deg, const std::vector<char>* only = nullptr);
 
 ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, const WetParams& params,
                           std::vector<Bridge> bridges, Solver& solver, Eigen::VectorXd& q,

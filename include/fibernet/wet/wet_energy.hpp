@@ -2,7 +2,7 @@
 // The wet network's energy at a fixed box deformation F, as a solver sees it (issue 6, part 1):
 //   E(q) = dry stretching + bending (NetworkEnergy, unchanged) + sum over bridges of the blended capillary element
 // (bridge.hpp). The bridge set is fixed for the lifetime of a WetEnergy: the Hessian pattern (the dry pattern united
-// with each bridge's 8-node block) is built once here, and the active-set loop (active_set.hpp) makes a new WetEnergy
+// with each bridge's 8-node block) is built once, on first use, and the active-set loop (active_set.hpp) makes a new WetEnergy
 // when the set changes. With beta = 0 no bridge term is evaluated and the pattern is the dry one, so every value,
 // gradient and Hessian (and hence every solve) is bit for bit the dry one.
 #include <Eigen/Core>
@@ -34,7 +34,7 @@ public:
     double value(const Eigen::VectorXd& q) override;
     double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override;
     double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool project_psd) override;
-    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override;
 
     WetSplit split(const Eigen::VectorXd& q) const;
     // Each bridge's own energy at q (for reports and the continuity test).
@@ -55,9 +55,11 @@ private:
     std::vector<Bridge> bridges_;
     std::vector<BridgeElement> elements_;
     WetParams params_;
-    Eigen::SparseMatrix<double> pattern_, dry_H_;
-    std::vector<int> dry_slot_;     // dry pattern value index -> union value index
-    std::vector<int> bridge_slots_; // 256 per bridge: union value index of local (a, b) with row <= col, else -1
+    // Built on first use (hessian_pattern()).
+    mutable bool pattern_built_ = false;
+    mutable Eigen::SparseMatrix<double> pattern_, dry_H_;
+    mutable std::vector<int> dry_slot_;     // dry pattern value index -> union value index
+    mutable std::vector<int> bridge_slots_; // 256 per bridge: union value index of local (a, b) with row <= col, else -1
     EnergyEval eval_;
     // Per-chunk element results (eval): filled in parallel, summed in element order.
     static constexpr size_t kChunk = 2048, kParallelMin = 1024;

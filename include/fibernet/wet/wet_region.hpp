@@ -1,0 +1,67 @@
+#pragma once
+// Parts of the wet network solved on their own (issue 6, "Performance"). On a large network the events of a round
+// (bridges that move, form or rupture) are local, and after the first rounds most of the network is near equilibrium:
+// at 3000 fibers 2-6 % of the coordinates carry |g| > 1e-4 after round 10 (docs/benchmarks.md, "Local rounds"). A
+// WetRegion is the energy as a function of the coordinates of a set of nodes only, every other node held where it is.
+// The connected parts of a region share no element, so their energies are independent: each is minimized on its own,
+// with its own line search, at the cost of its size (a global line search is set by the network's worst spot).
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "fibernet/energy/objective.hpp"
+#include "fibernet/wet/wet_energy.hpp"
+
+namespace fibernet {
+
+// The elements of W at each node (compressed rows): segments, hinges and bridges, for building regions in time
+// proportional to their size.
+struct ElementIncidence {
+    std::vector<int> seg_start, seg, hinge_start, hinge, bridge_start, bridge;
+};
+ElementIncidence element_incidence(const WetEnergy& W);
+
+// Flags (one per node) the nodes holding a free coordinate with |g| > threshold.
+std::vector<char> nodes_above(const NetworkEnergy& dry, const Eigen::VectorXd& g, double threshold);
+// Grows the flagged set `hops` times by whole elements of W (a node joins when it shares a segment, hinge or bridge
+// with a node already in).
+void grow_region(const WetEnergy& W, std::vector<char>& in, int hops);
+// The flagged nodes split into parts joined by elements (nodes of distinct parts share no element); each sorted.
+std::vector<std::vector<int>> region_parts(const WetEnergy& W, const ElementIncidence& inc, const std::vector<char>& in);
+
+class WetRegion : public Objective {
+public:
+    // W's energy as a function of the free coordinates of `nodes`; the other nodes keep their positions in q. Elements
+    // with no node in the region are left out: their energy is constant here, so value() is W's energy less a
+    // constant, and gradient and Hessian are W's restricted to the region's coordinates.
+    WetRegion(const WetEnergy& W, const Eigen::VectorXd& q, const std::vector<int>& nodes, const ElementIncidence& inc);
+
+    int size() const override { return static_cast<int>(dofs_.size()); }
+    double value(const Eigen::VectorXd& qa) override { return eval(qa, nullptr, nullptr, false); }
+    double gradient(const Eigen::VectorXd& qa, Eigen::VectorXd& g) override { return eval(qa, &g, nullptr, false); }
+    double hessian(const Eigen::VectorXd& qa, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool psd) override {
+        return eval(qa, &g, &H, psd);
+    }
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
+
+    // The region's coordinates of a full state, and back into one.
+    Eigen::VectorXd restrict(const Eigen::VectorXd& q) const;
+    void embed(const Eigen::VectorXd& qa, Eigen::VectorXd& q) const;
+    const std::vector<int>& dofs() const { return dofs_; }  // region coordinate -> coordinate of W
+
+private:
+    double eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd);
+
+    const WetEnergy& W_;
+    // Every node's displacement and position at q (NetworkEnergy::displacements, positions); an evaluation rewrites
+    // the region's entries only, so it costs the region's size.
+    Eigen::VectorXd u_, x_;
+    std::vector<int> dofs_, dof_node_;           // region coordinate -> coordinate of W, and its node's u_ index
+    std::vector<int> segs_, hinges_, bridges_;  // elements with a node in the region
+    // Per element: region index of each local coordinate (-1: held), and the Hessian value slot of each local pair
+    // (a, b) with row <= column (-1 otherwise); segment 4 / 16, hinge 6 / 36, bridge 16 / 256.
+    std::vector<int> seg_idx_, hinge_idx_, bridge_idx_, seg_slot_, hinge_slot_, bridge_slot_;
+    Eigen::SparseMatrix<double> pattern_;
+};
+
+}  // namespace fibernet

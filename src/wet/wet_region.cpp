@@ -1,0 +1,268 @@
+#include "fibernet/wet/wet_region.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace fibernet {
+
+namespace {
+// Calls f(nodes, count) for every element of W: segments, hinges and bridges (absent bridge nodes are -1).
+template <class F>
+void for_each_element(const WetEnergy& W, F f) {
+    const Model& m = W.dry().model();
+    for (const Segment& s : m.segments) {
+        const int n[2] = {s.i, s.j};
+        f(n, 2);
+    }
+    for (const Hinge& h : m.hinges) {
+        const int n[3] = {h.i, h.j, h.k};
+        f(n, 3);
+    }
+    if (W.params().beta != 0)
+        for (const BridgeElement& e : W.elements()) f(e.node, 8);
+}
+}  // namespace
+
+ElementIncidence element_incidence(const WetEnergy& W) {
+    const Model& m = W.dry().model();
+    const int nn = m.num_nodes();
+    ElementIncidence inc;
+    // Counting sort of (node, element) pairs into compressed rows.
+    auto build = [&](int ne, auto nodes_of, std::vector<int>& start, std::vector<int>& list) {
+        start.assign(nn + 1, 0);
+        for (int e = 0; e < ne; ++e) {
+            int k = 0;
+            const int* n = nodes_of(e, k);
+            for (int a = 0; a < k; ++a)
+                if (n[a] >= 0 && std::find(n, n + a, n[a]) == n + a) ++start[n[a] + 1];
+        }
+        for (int i = 0; i < nn; ++i) start[i + 1] += start[i];
+        list.resize(start[nn]);
+        std::vector<int> fill(start.begin(), start.end() - 1);
+        for (int e = 0; e < ne; ++e) {
+            int k = 0;
+            const int* n = nodes_of(e, k);
+            for (int a = 0; a < k; ++a)
+                if (n[a] >= 0 && std::find(n, n + a, n[a]) == n + a) list[fill[n[a]]++] = e;
+        }
+    };
+    std::vector<int> buf(3);
+    build(static_cast<int>(m.segments.size()), [&](int e, int& k) {
+        buf[0] = m.segments[e].i, buf[1] = m.segments[e].j, k = 2;
+        return buf.data();
+    }, inc.seg_start, inc.seg);
+    build(static_cast<int>(m.hinges.size()), [&](int e, int& k) {
+        buf[0] = m.hinges[e].i, buf[1] = m.hinges[e].j, buf[2] = m.hinges[e].k, k = 3;
+        return buf.data();
+    }, inc.hinge_start, inc.hinge);
+    const bool wet = W.params().beta != 0;
+    build(wet ? static_cast<int>(W.elements().size()) : 0, [&](int e, int& k) {
+        k = 8;
+        return W.elements()[e].node;
+    }, inc.bridge_start, inc.bridge);
+    return inc;
+}
+
+std::vector<char> nodes_above(const NetworkEnergy& dry, const Eigen::VectorXd& g, double threshold) {
+    const int nn = dry.model().num_nodes();
+    std::vector<char> in(nn, 0);
+    for (int i = 0; i < nn; ++i)
+        for (int c = 0; c < 2; ++c)
+            if (dry.dof(i, c) >= 0 && std::abs(g[dry.dof(i, c)]) > threshold) in[i] = 1;
+    return in;
+}
+
+void grow_region(const WetEnergy& W, std::vector<char>& in, int hops) {
+    for (int h = 0; h < hops; ++h) {
+        std::vector<char> next = in;
+        for_each_element(W, [&](const int* n, int k) {
+            bool any = false;
+            for (int a = 0; a < k && !any; ++a) any = n[a] >= 0 && in[n[a]];
+            if (any)
+                for (int a = 0; a < k; ++a)
+                    if (n[a] >= 0) next[n[a]] = 1;
+        });
+        in.swap(next);
+    }
+}
+
+std::vector<std::vector<int>> region_parts(const WetEnergy& W, const ElementIncidence& inc, const std::vector<char>& in) {
+    const Model& m = W.dry().model();
+    const int nn = m.num_nodes();
+    std::vector<int> part(nn, -1);
+    std::vector<std::vector<int>> parts;
+    std::vector<int> stack;
+    for (int s = 0; s < nn; ++s) {
+        if (!in[s] || part[s] >= 0) continue;
+        const int id = static_cast<int>(parts.size());
+        parts.emplace_back();
+        part[s] = id, stack.assign(1, s);
+        auto visit = [&](int v) {
+            if (v >= 0 && in[v] && part[v] < 0) part[v] = id, stack.push_back(v);
+        };
+        while (!stack.empty()) {
+            const int v = stack.back();
+            stack.pop_back();
+            parts[id].push_back(v);
+            for (int k = inc.seg_start[v]; k < inc.seg_start[v + 1]; ++k)
+                visit(m.segments[inc.seg[k]].i), visit(m.segments[inc.seg[k]].j);
+            for (int k = inc.hinge_start[v]; k < inc.hinge_start[v + 1]; ++k)
+                visit(m.hinges[inc.hinge[k]].i), visit(m.hinges[inc.hinge[k]].j), visit(m.hinges[inc.hinge[k]].k);
+            for (int k = inc.bridge_start[v]; k < inc.bridge_start[v + 1]; ++k)
+                for (int a = 0; a < 8; ++a) visit(W.elements()[inc.bridge[k]].node[a]);
+        }
+        std::sort(parts[id].begin(), parts[id].end());
+    }
+    return parts;
+}
+
+WetRegion::WetRegion(const WetEnergy& W, const Eigen::VectorXd& q, const std::vector<int>& nodes,
+                     const ElementIncidence& inc)
+    : W_(W) {
+    const NetworkEnergy& dry = W.dry();
+    const Model& m = dry.model();
+    u_ = dry.displacements(q, W.F());
+    x_ = dry.positions(q, W.F());
+    // Region index of each coordinate of W (only the region's nodes' entries are looked up).
+    std::vector<int> order(nodes);
+    std::sort(order.begin(), order.end());
+    auto local = [&](int node, int c) -> int {
+        const int d = dry.dof(node, c);
+        if (d < 0 || !std::binary_search(order.begin(), order.end(), node)) return -1;
+        return 2 * static_cast<int>(std::lower_bound(order.begin(), order.end(), node) - order.begin()) + c;
+    };
+    // Coordinates: 2 per node in sorted order, fixed ones (no coordinate) left out below by compaction.
+    std::vector<int> compact(2 * order.size(), -1);
+    for (size_t k = 0; k < order.size(); ++k)
+        for (int c = 0; c < 2; ++c)
+            if (dry.dof(order[k], c) >= 0) {
+                compact[2 * k + c] = static_cast<int>(dofs_.size());
+                dofs_.push_back(dry.dof(order[k], c));
+                dof_node_.push_back(2 * order[k] + c);
+            }
+    auto index = [&](const int* n, int k, std::vector<int>& out) {
+        for (int a = 0; a < 2 * k; ++a) {
+            const int l = n[a / 2] < 0 ? -1 : local(n[a / 2], a % 2);
+            out.push_back(l < 0 ? -1 : compact[l]);
+        }
+    };
+    // Elements at the region's nodes, each once.
+    auto gather = [&](const std::vector<int>& start, const std::vector<int>& list, std::vector<int>& out) {
+        for (int v : order) out.insert(out.end(), list.begin() + start[v], list.begin() + start[v + 1]);
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+    };
+    gather(inc.seg_start, inc.seg, segs_);
+    gather(inc.hinge_start, inc.hinge, hinges_);
+    gather(inc.bridge_start, inc.bridge, bridges_);
+    for (int e : segs_) {
+        const int n[2] = {m.segments[e].i, m.segments[e].j};
+        index(n, 2, seg_idx_);
+    }
+    for (int e : hinges_) {
+        const int n[3] = {m.hinges[e].i, m.hinges[e].j, m.hinges[e].k};
+        index(n, 3, hinge_idx_);
+    }
+    for (int e : bridges_) index(W.elements()[e].node, 8, bridge_idx_);
+
+    // Upper-triangular pattern over the region's coordinates, then each element's value slots.
+    const int n = size();
+    std::vector<std::vector<int>> cols(n);
+    auto collect = [&](const std::vector<int>& idx, int M) {
+        for (size_t e = 0; e < idx.size(); e += M)
+            for (int a = 0; a < M; ++a)
+                for (int b = 0; b < M; ++b) {
+                    const int r = idx[e + a], c = idx[e + b];
+                    if (r >= 0 && c >= 0 && r <= c) cols[c].push_back(r);
+                }
+    };
+    collect(seg_idx_, 4), collect(hinge_idx_, 6), collect(bridge_idx_, 16);
+    std::vector<int> outer(n + 1, 0), inner;
+    for (int c = 0; c < n; ++c) {
+        auto& v = cols[c];
+        if (v.empty() || v.back() != c) v.push_back(c);  // a diagonal entry for every coordinate
+        std::sort(v.begin(), v.end());
+        v.erase(std::unique(v.begin(), v.end()), v.end());
+        inner.insert(inner.end(), v.begin(), v.end());
+        outer[c + 1] = static_cast<int>(inner.size());
+    }
+    std::vector<double> zeros(inner.size(), 0.0);
+    pattern_ = Eigen::Map<const Eigen::SparseMatrix<double>>(n, n, static_cast<Eigen::Index>(inner.size()), outer.data(),
+                                                            inner.data(), zeros.data());
+    pattern_.makeCompressed();
+    auto slots = [&](const std::vector<int>& idx, int M, std::vector<int>& out) {
+        out.assign(idx.size() / M * M * M, -1);
+        for (size_t e = 0; e < idx.size() / M; ++e)
+            for (int a = 0; a < M; ++a)
+                for (int b = 0; b < M; ++b) {
+                    const int r = idx[e * M + a], c = idx[e * M + b];
+                    if (r < 0 || c < 0 || r > c) continue;
+                    const int* in = pattern_.innerIndexPtr();
+                    const int* it = std::lower_bound(in + pattern_.outerIndexPtr()[c], in + pattern_.outerIndexPtr()[c + 1], r);
+                    out[e * M * M + a * M + b] = static_cast<int>(it - in);
+                }
+    };
+    slots(seg_idx_, 4, seg_slot_), slots(hinge_idx_, 6, hinge_slot_), slots(bridge_idx_, 16, bridge_slot_);
+}
+
+Eigen::VectorXd WetRegion::restrict(const Eigen::VectorXd& q) const {
+    Eigen::VectorXd qa(size());
+    for (int i = 0; i < size(); ++i) qa[i] = q[dofs_[i]];
+    return qa;
+}
+
+void WetRegion::embed(const Eigen::VectorXd& qa, Eigen::VectorXd& q) const {
+    for (int i = 0; i < size(); ++i) q[dofs_[i]] = qa[i];
+}
+
+double WetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) {
+    const NetworkEnergy& dry = W_.dry();
+    const Eigen::Matrix2d& F = W_.F();
+    const Eigen::VectorXd& xr = dry.model().x;
+    for (int i = 0; i < size(); ++i) u_[dof_node_[i]] = qa[i], x_[dof_node_[i]] = xr[dof_node_[i]] + qa[i];
+    const Eigen::VectorXd& u = u_;
+    if (g) g->setZero(size());
+    double* hv = nullptr;
+    if (H) {
+        if (H->nonZeros() != pattern_.nonZeros()) throw std::logic_error("Hessian lacks the region's pattern");
+        hv = H->valuePtr();
+        std::fill(hv, hv + H->nonZeros(), 0.0);
+    }
+    // Adds an element's gradient and Hessian (M local coordinates) through its index and slot tables.
+    auto add = [&](const int* idx, const int* slot, int M, const double* ge, const double* he) {
+        if (g)
+            for (int a = 0; a < M; ++a)
+                if (idx[a] >= 0) (*g)[idx[a]] += ge[a];
+        if (H)
+            for (int j = 0; j < M * M; ++j)
+                if (slot[j] >= 0) hv[slot[j]] += he[(j % M) * M + j / M];  // column-major element block
+    };
+    double E = 0;
+    Eigen::Vector4d g4;
+    Eigen::Matrix4d H4;
+    for (size_t k = 0; k < segs_.size(); ++k) {
+        E += dry.segment_term(segs_[k], u, F, g ? &g4 : nullptr, H ? &H4 : nullptr, psd);
+        add(&seg_idx_[4 * k], H ? &seg_slot_[16 * k] : nullptr, 4, g4.data(), H4.data());
+    }
+    Eigen::Matrix<double, 6, 1> g6;
+    Eigen::Matrix<double, 6, 6> H6;
+    for (size_t k = 0; k < hinges_.size(); ++k) {
+        E += dry.hinge_term(hinges_[k], u, F, g ? &g6 : nullptr, H ? &H6 : nullptr, psd);
+        add(&hinge_idx_[6 * k], H ? &hinge_slot_[36 * k] : nullptr, 6, g6.data(), H6.data());
+    }
+    if (!bridges_.empty()) {
+        const Eigen::VectorXd& x = x_;
+        const Eigen::Matrix2d B = F * dry.model().box.B0();
+        Vector16d g16;
+        Matrix16d H16;
+        for (size_t k = 0; k < bridges_.size(); ++k) {
+            const BridgeElement& e = W_.elements()[bridges_[k]];
+            E += bridge_element_energy(e, element_coordinates(e, x, B), W_.params().beta, W_.params().law,
+                                       g ? &g16 : nullptr, H ? &H16 : nullptr, psd);
+            add(&bridge_idx_[16 * k], H ? &bridge_slot_[256 * k] : nullptr, 16, g16.data(), H16.data());
+        }
+    }
+    return E;
+}
+
+}  // namespace fibernet

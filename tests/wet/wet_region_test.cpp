@@ -1,0 +1,148 @@
+// A region of the wet network (wet_region.hpp) is the whole energy restricted to its coordinates: same gradient and
+// Hessian entries, value changes equal, with the rest held; hot_region grows by whole elements. And the active-set loop
+// with local rounds still ends at an equilibrium of every coordinate.
+#include <catch2/catch.hpp>
+
+#include "fibernet/solve/newton.hpp"
+#include "fibernet/wet/active_set.hpp"
+#include "fibernet/wet/wet_region.hpp"
+#include "wet_fixtures.hpp"
+
+using namespace fibernet;
+using namespace wetfix;
+
+namespace {
+Eigen::MatrixXd dense(const Eigen::SparseMatrix<double>& upper) {
+    const Eigen::MatrixXd U(upper);
+    return Eigen::MatrixXd(U.selfadjointView<Eigen::Upper>());
+}
+
+void check_region(const Model& m, const Eigen::Matrix2d& F, std::uint64_t seed) {
+    NetworkEnergy dry(m);
+    Eigen::VectorXd q = perturb(dry.affine_map(dry.dofs(m.x), Eigen::Matrix2d::Identity(), F), 0.02, seed);
+    const std::vector<Bridge> bridges = segment_crossings(m, dry.positions(q, F), F * m.box.B0());
+    REQUIRE(bridges.size() >= 5);
+    WetParams p;
+    p.beta = 0.7;
+    WetEnergy W(dry, F, bridges, p);
+    // A random third of the nodes (fixed nodes included: they have no coordinates and stay out).
+    Rng rng(seed + 7);
+    std::vector<char> active(m.num_nodes());
+    for (auto& a : active) a = rng.uniform() < 0.33;
+    std::vector<int> nodes;
+    for (int i = 0; i < m.num_nodes(); ++i)
+        if (active[i]) nodes.push_back(i);
+    WetRegion R(W, q, nodes, element_incidence(W));
+    REQUIRE(R.size() > 10);
+    REQUIRE(R.size() < W.size());
+    Eigen::VectorXd g, ga;
+    Eigen::SparseMatrix<double> H = W.hessian_pattern(), Ha = R.hessian_pattern();
+    W.hessian(q, g, H, false);
+    const Eigen::VectorXd qa = R.restrict(q);
+    R.hessian(qa, ga, Ha, false);
+    const Eigen::MatrixXd Hf = dense(H), Hr = dense(Ha);
+    const std::vector<int>& d = R.dofs();
+    double dg = 0, dH = 0;
+    for (int i = 0; i < R.size(); ++i) {
+        dg = std::max(dg, std::abs(ga[i] - g[d[i]]));
+        for (int j = 0; j < R.size(); ++j) dH = std::max(dH, std::abs(Hr(i, j) - Hf(d[i], d[j])));
+    }
+    CHECK(dg <= 1e-12 * g.cwiseAbs().maxCoeff());
+    CHECK(dH <= 1e-12 * Hf.cwiseAbs().maxCoeff());
+    // Every region coordinate belongs to an active node, and only free coordinates are in.
+    for (int i = 0; i < m.num_nodes(); ++i)
+        for (int c = 0; c < 2; ++c)
+            if (dry.dof(i, c) >= 0)
+                CHECK(active[i] == (std::find(d.begin(), d.end(), dry.dof(i, c)) != d.end()));
+    // A step in the region changes both values alike, and embed writes only the region's coordinates.
+    const Eigen::VectorXd qa2 = perturb(qa, 0.01, seed + 3);
+    Eigen::VectorXd q2 = q;
+    R.embed(qa2, q2);
+    CHECK(R.value(qa2) - R.value(qa) == Approx(W.value(q2) - W.value(q)).margin(1e-10));
+    int changed = 0;
+    for (int i = 0; i < q.size(); ++i) changed += q2[i] != q[i];
+    CHECK(changed <= R.size());
+    CHECK((R.restrict(q2) - qa2).norm() == 0);
+}
+}  // namespace
+
+TEST_CASE("wet region: gradient, Hessian and value changes are the whole energy's", "[wet][region]") {
+    const Network net = mikado(2.5, 6, 0.5, 5);
+    Eigen::Matrix2d F;
+    F << 1.02, 0.08, 0.0, 0.99;  // sheared, across periodic images
+    check_region(model_of(net, 8), F, 1);
+    check_region(model_of(net, 8), Eigen::Matrix2d::Identity(), 2);
+    // Fixed nodes (clamps) sit at F x_ref and have no coordinates.
+    Model mc = model_of(net, 8);
+    mc.fixed.assign(mc.num_nodes(), 0);
+    for (int i = 0; i < mc.num_nodes(); i += 7) mc.fixed[i] = 1;
+    check_region(mc, F, 3);
+}
+
+TEST_CASE("wet region: nodes by |g|, grown by whole elements, split into independent parts", "[wet][region]") {
+    // Two straight fibers far apart, 10 segments each: node k's elements reach k +- 1 (segments) and k +- 2 (hinges).
+    const Network net = network_of({{1.0, 1.0, 0.0, 1.0, 0.5}, {1.0, 2.5, 0.0, 1.0, 0.5}}, 4.0);
+    const Model m = model_of(net, 10);
+    NetworkEnergy dry(m);
+    WetEnergy W(dry, Eigen::Matrix2d::Identity(), {}, WetParams{});
+    const auto& chain = m.chains[0].nodes;
+    const int k = chain[5];
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(dry.num_dofs());
+    g[dry.dof(k, 1)] = -1e-3;
+    g[dry.dof(chain[1], 0)] = 1e-5;  // under the threshold
+    auto count = [](const std::vector<char>& v) { return std::count(v.begin(), v.end(), 1); };
+    auto grown = [&](double thr, int hops) {
+        std::vector<char> in = nodes_above(dry, g, thr);
+        grow_region(W, in, hops);
+        return in;
+    };
+    CHECK(count(grown(1e-4, 0)) == 1);
+    CHECK(grown(1e-4, 0)[k]);
+    const std::vector<char> one = grown(1e-4, 1);
+    CHECK(count(one) == 5);
+    for (int j = 3; j <= 7; ++j) CHECK(one[chain[j]]);
+    CHECK(count(grown(1e-4, 2)) == 9);
+    CHECK(count(grown(1e-6, 0)) == 2);
+    CHECK(count(grown(1e-2, 3)) == 0);
+    // Parts: nodes 1 and 5 of fiber 0 grown by one hop (segments and hinges reach 2 nodes) touch: one part; with a
+    // node of fiber 1 added, two.
+    const ElementIncidence inc = element_incidence(W);
+    std::vector<char> in = grown(1e-6, 1);
+    CHECK(region_parts(W, inc, in).size() == 1);
+    in[m.chains[1].nodes[4]] = 1;
+    const auto parts = region_parts(W, inc, in);
+    REQUIRE(parts.size() == 2);
+    CHECK(parts[0].size() + parts[1].size() == static_cast<size_t>(count(in)));
+    // Nodes 0 and 9 of fiber 0 alone share no element (hinges reach 2 nodes): two parts.
+    std::vector<char> ends(m.num_nodes(), 0);
+    ends[chain[0]] = ends[chain[9]] = 1;
+    CHECK(region_parts(W, inc, ends).size() == 2);
+    ends[chain[2]] = 1;  // shares a hinge with node 0
+    CHECK(region_parts(W, inc, ends).size() == 2);
+}
+
+TEST_CASE("wet relaxation: local rounds end at an equilibrium of the whole network", "[wet][region][relax]") {
+    const Network net = mikado(4.0, 6, 0.5, 3);
+    const Model m = model_of(net, 8);
+    NetworkEnergy e(m);
+    WetParams p;
+    p.beta = 0.05;
+    const auto initial = wet_crossings(net, m, m.x, m.box.B0(), {});
+    SolverOptions so;
+    so.tol = 1e-9, so.max_iter = 300;
+    ActiveSetOptions opt;
+    opt.local_fraction = 0.5;  // a small network: let regions be half of it
+    Eigen::VectorXd q = e.dofs(m.x);
+    auto s = make_solver("newton", so);
+    const ActiveSetResult r = relax_wet(e, Eigen::Matrix2d::Identity(), p, initial, *s, q, opt);
+    INFO(r.message << "; local rounds " << r.local_rounds << " of " << r.rounds);
+    CHECK(r.local_rounds > 0);
+    REQUIRE(r.stable);
+    REQUIRE(r.last.converged());
+    Eigen::VectorXd g;
+    WetEnergy W(e, Eigen::Matrix2d::Identity(), r.bridges, p);
+    CHECK(W.gradient(q, g) == Approx(r.last.energy).epsilon(1e-12));
+    CHECK(g.cwiseAbs().maxCoeff() <= so.tol);
+    std::vector<Bridge> b = r.bridges;
+    CHECK(update_bridges(e, q, Eigen::Matrix2d::Identity(), b).total() == 0);
+}
