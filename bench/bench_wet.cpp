@@ -2,7 +2,7 @@
 // scheme) relaxed dry, wetted at all crossings and relaxed under capillary load with mobile bridges.
 // Prints one JSON line per run with the time split: dry Newton, wet Newton, event handling, pore analysis.
 //   bench_wet [N=1000] [q=10] [beta=0.01] [max_rounds=1000] [newton_max_iter=500] [scheme=seed] [seed=1] [move_margin=0.1]
-//             [round_iterations=10] [warm_start=1] [newton_ldl=1] [local_fraction=0.25] [local_threshold=1e-2]
+//             [round_iterations=10] [warm_start=1] [newton_ldl=1] [local_fraction=0.25] [local_threshold=0.1]
 //             [local_hops=3]
 // The "newton" block sums the wet solves' time split over all rounds.
 // Environment: BENCH_VERBOSE=1 prints a line per active-set round, BENCH_NEWTON_VERBOSE=1 a line per Newton iteration.

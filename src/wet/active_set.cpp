@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <iterator>
 #include <map>
+#include <memory>
 #include <set>
 #include <utility>
 
@@ -100,7 +101,7 @@ void near_pairs(const Model& m, const SegGeom& g, const Eigen::Matrix2d& B, doub
     };
     for (int e = 0; e < ns; ++e) cell[cell_of(U[e], 0) + nc[0] * cell_of(U[e], 1)].push_back(e);
     auto test = [&](int a, int b) {
-        if (g.fiber[a] == g.fiber[b] || (only && !(*only)[a] && !(*only)[b])) return;
+        if (g.fiber[a] == g.fiber[b]) return;
         const Segment &sa = m.segments[a], &sb = m.segments[b];
         if (sa.i == sb.i || sa.i == sb.j || sa.j == sb.i || sa.j == sb.j) return;  // meet at a shared node
         Eigen::Vector2d Pb = g.P[b];
@@ -111,6 +112,22 @@ void near_pairs(const Model& m, const SegGeom& g, const Eigen::Matrix2d& B, doub
         visit(a, b, Pb);
     };
     const bool all = nc[0] == 1 && nc[1] == 1;
+    if (only) {  // from the flagged segments alone, each pair once (a flagged pair from its lower index)
+        for (int a = 0; a < ns; ++a) {
+            if (!(*only)[a]) continue;
+            const int cx = cell_of(U[a], 0), cy = cell_of(U[a], 1);
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    if (all && (dx || dy)) continue;
+                    int X = cx + dx, Y = cy + dy;
+                    if (m.box.periodic) X = (X + nc[0]) % nc[0], Y = (Y + nc[1]) % nc[1];
+                    else if (X < 0 || Y < 0 || X >= nc[0] || Y >= nc[1]) continue;
+                    for (int b : cell[X + nc[0] * Y])
+                        if (b != a && !((*only)[b] && b < a)) test(std::min(a, b), std::max(a, b));
+                }
+        }
+        return;
+    }
     for (int cy = 0; cy < nc[1]; ++cy)
         for (int cx = 0; cx < nc[0]; ++cx)
             for (int a : cell[cx + nc[0] * cy]) {
@@ -371,9 +388,12 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
     bool resume = false;  // the last round was cut at round_iterations: the next one resumes its solve
     const bool use_local = opt.local_fraction > 0 && params.beta > 0;
     std::vector<char> region;  // non-empty: the next round is local, on these nodes
+    std::unique_ptr<WetEnergy> next;
     for (int round = 1; round <= opt.max_rounds; ++round) {
         r.rounds = round;
-        WetEnergy W(dry, F, bridges, params);
+        // The energy of this round's set: the one the last round's gradient was taken with, if there was one.
+        std::unique_ptr<WetEnergy> Wp = next ? std::move(next) : std::make_unique<WetEnergy>(dry, F, bridges, params);
+        WetEnergy& W = *Wp;
         double t0 = now();
         so.max_iter = capped ? opt.round_iterations : budget;
         so.warm_start = (resume && opt.warm_start) || restore.saved.warm_start;  // Newton: keep its adapted shift
@@ -390,8 +410,9 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             so.warm_start = restore.saved.warm_start;  // each part adapts its own shift
             SolveResult all;
             all.status = SolveStatus::Converged, all.solver = solver.name();
+            RegionState state(W, q);
             for (const auto& nodes : parts) {
-                WetRegion R(W, q, nodes, inc);
+                WetRegion R(W, state, nodes, inc);
                 if (R.size() == 0) continue;
                 region_size += R.size();
                 Eigen::VectorXd qa = R.restrict(q);
@@ -441,7 +462,8 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         double gmax = 0, E_full = 0;
         Eigen::VectorXd g;
         if (r.last.converged() || use_local) {
-            WetEnergy Wn(dry, F, bridges, params);
+            next = std::make_unique<WetEnergy>(dry, F, bridges, params);
+            WetEnergy& Wn = *next;
             E_full = Wn.gradient(q, g);
             gmax = g.size() ? g.cwiseAbs().maxCoeff() : 0.0;
             equilibrium = r.last.converged() && gmax <= r.last.grad_max * (1 + 1e-9);
@@ -544,6 +566,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         r.message = "no stable bridge set after " + std::to_string(r.rounds) + " rounds (last solve: " +
                     to_string(r.last.status) + ")";
     r.bridges = std::move(bridges);
+    r.frozen = std::move(frozen);
     return r;
 }
 

@@ -116,13 +116,13 @@ std::vector<std::vector<int>> region_parts(const WetEnergy& W, const ElementInci
     return parts;
 }
 
-WetRegion::WetRegion(const WetEnergy& W, const Eigen::VectorXd& q, const std::vector<int>& nodes,
-                     const ElementIncidence& inc)
-    : W_(W) {
+RegionState::RegionState(const WetEnergy& W, const Eigen::VectorXd& q)
+    : u(W.dry().displacements(q, W.F())), x(W.dry().positions(q, W.F())) {}
+
+WetRegion::WetRegion(const WetEnergy& W, RegionState& state, const std::vector<int>& nodes, const ElementIncidence& inc)
+    : W_(W), u_(state.u), x_(state.x) {
     const NetworkEnergy& dry = W.dry();
     const Model& m = dry.model();
-    u_ = dry.displacements(q, W.F());
-    x_ = dry.positions(q, W.F());
     // Region index of each coordinate of W (only the region's nodes' entries are looked up).
     std::vector<int> order(nodes);
     std::sort(order.begin(), order.end());

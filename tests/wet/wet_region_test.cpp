@@ -32,7 +32,8 @@ void check_region(const Model& m, const Eigen::Matrix2d& F, std::uint64_t seed) 
     std::vector<int> nodes;
     for (int i = 0; i < m.num_nodes(); ++i)
         if (active[i]) nodes.push_back(i);
-    WetRegion R(W, q, nodes, element_incidence(W));
+    RegionState state(W, q);
+    WetRegion R(W, state, nodes, element_incidence(W));
     REQUIRE(R.size() > 10);
     REQUIRE(R.size() < W.size());
     Eigen::VectorXd g, ga;
@@ -63,6 +64,30 @@ void check_region(const Model& m, const Eigen::Matrix2d& F, std::uint64_t seed) 
     for (int i = 0; i < q.size(); ++i) changed += q2[i] != q[i];
     CHECK(changed <= R.size());
     CHECK((R.restrict(q2) - qa2).norm() == 0);
+
+    // The parts of the region are independent: moved one after another through one shared state, each part's gradient
+    // at its own new coordinates is the whole energy's at the final state.
+    const ElementIncidence inc = element_incidence(W);
+    const auto parts = region_parts(W, inc, active);
+    REQUIRE(parts.size() >= 2);
+    RegionState shared(W, q);
+    Eigen::VectorXd q3 = q, gfull;
+    std::vector<Eigen::VectorXd> part_g;
+    std::vector<std::vector<int>> part_dofs;
+    for (size_t k = 0; k < parts.size(); ++k) {
+        WetRegion P(W, shared, parts[k], inc);
+        const Eigen::VectorXd qk = perturb(P.restrict(q3), 0.01, seed + 11 + k);
+        Eigen::VectorXd gk;
+        P.gradient(qk, gk);
+        P.value(perturb(qk, 0.05, seed + 99));  // a rejected trial point left in the shared state
+        P.embed(qk, q3);
+        part_g.push_back(gk), part_dofs.push_back(P.dofs());
+    }
+    W.gradient(q3, gfull);
+    double dp = 0;
+    for (size_t k = 0; k < parts.size(); ++k)
+        for (size_t i = 0; i < part_dofs[k].size(); ++i) dp = std::max(dp, std::abs(part_g[k][i] - gfull[part_dofs[k][i]]));
+    CHECK(dp <= 1e-12 * gfull.cwiseAbs().maxCoeff());
 }
 }  // namespace
 
@@ -144,5 +169,43 @@ TEST_CASE("wet relaxation: local rounds end at an equilibrium of the whole netwo
     CHECK(W.gradient(q, g) == Approx(r.last.energy).epsilon(1e-12));
     CHECK(g.cwiseAbs().maxCoeff() <= so.tol);
     std::vector<Bridge> b = r.bridges;
-    CHECK(update_bridges(e, q, Eigen::Matrix2d::Identity(), b).total() == 0);
+    CHECK(static_cast<int>(r.frozen.size()) == r.frozen_pairs);
+    CHECK(update_bridges(e, q, Eigen::Matrix2d::Identity(), b, {}, &r.frozen).total() == 0);  // but on frozen pairs
+}
+
+TEST_CASE("wet region: crossing and contact search from flagged segments finds the full search's pairs", "[wet][region]") {
+    for (double L : {2.5, 6.0}) {  // one cell holding everything, and a cell list
+        const Network net = mikado(L, 8, 0.5, 9);
+        const Model m = model_of(net, 8);
+        NetworkEnergy dry(m);
+        Eigen::Matrix2d F;
+        F << 1.0, 0.1, 0.0, 1.0;
+        const Eigen::VectorXd x = dry.positions(perturb(dry.affine_map(dry.dofs(m.x), Eigen::Matrix2d::Identity(), F), 0.05, 4), F);
+        const Eigen::Matrix2d B = F * m.box.B0();
+        Rng rng(17);
+        std::vector<char> only(m.segments.size());
+        for (auto& o : only) o = rng.uniform() < 0.2;
+        auto flagged = [&](const Bridge& b) {
+            return only[m.chains[b.f1].segments[b.k1]] || only[m.chains[b.f2].segments[b.k2]];
+        };
+        auto keys = [](std::vector<Bridge> v) {
+            std::vector<std::array<int, 6>> k;
+            for (const Bridge& b : v) k.push_back({b.f1, b.f2, b.k1, b.k2, b.image.x(), b.image.y()});
+            std::sort(k.begin(), k.end());
+            return k;
+        };
+        std::vector<Bridge> all = segment_crossings(m, x, B), want;
+        for (const Bridge& b : all)
+            if (flagged(b)) want.push_back(b);
+        INFO("L " << L << ": " << all.size() << " crossings, " << want.size() << " at flagged segments");
+        REQUIRE(want.size() >= 5);
+        REQUIRE(want.size() < all.size());
+        CHECK(keys(segment_crossings(m, x, B, &only)) == keys(want));
+        std::vector<Bridge> ca = segment_contacts(m, x, B, 0.05, 30), cw;
+        for (const Bridge& b : ca)
+            if (flagged(b)) cw.push_back(b);
+        INFO(ca.size() << " contacts, " << cw.size() << " at flagged segments");
+        REQUIRE(cw.size() >= 2);
+        CHECK(keys(segment_contacts(m, x, B, 0.05, 30, &only)) == keys(cw));
+    }
 }

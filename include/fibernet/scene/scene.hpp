@@ -35,7 +35,7 @@ struct WetSettings {
     // Local rounds (docs/wet.md, "Local rounds"): the part of the network that needs a solve, if it holds at most
     // local_fraction of the coordinates (0: every round global); hot: |g| > local_threshold x max|g|, grown by local_hops.
     double local_fraction = 0.25;
-    double local_threshold = 1e-2;
+    double local_threshold = 0.1;
     int local_hops = 3;
 };
 

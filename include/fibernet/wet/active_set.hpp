@@ -57,7 +57,7 @@ struct ActiveSetOptions {
     // > the solver's tol), grown by local_hops elements, form the next round's region, solved with the rest held, if
     // it holds at most local_fraction of the coordinates; otherwise the round is global. 0: every round global.
     double local_fraction = 0.25;
-    double local_threshold = 1e-2;
+    double local_threshold = 0.1;
     int local_hops = 3;
     bool form_new = true;        // give new crossings and new contacts bridges
     double contact_distance = 0;  // seed units; 0: the fiber diameter 2 r = 2 ls / a
@@ -66,6 +66,9 @@ struct ActiveSetOptions {
     int max_freezes = 5;          // cycles broken by freezing their fiber pairs before cycling is final
     double move_margin = 0.1;     // a bridge moves once its crossing is this fraction of the blend half-width past a node
 };
+
+// Fiber pairs (lower index first).
+using FiberPairs = std::set<std::pair<int, int>>;
 
 struct ActiveSetResult {
     std::vector<Bridge> bridges;   // the final set
@@ -81,12 +84,11 @@ struct ActiveSetResult {
     bool cycling = false;          // a bridge set repeated after max_freezes cycles were broken
     int cycles_broken = 0;         // cycles broken by freezing the toggling fiber pairs
     int frozen_pairs = 0;          // fiber pairs whose bridges were frozen
+    FiberPairs frozen;             // ... which
     std::string message;
     double seconds_solve = 0, seconds_events = 0;
 };
 
-// Fiber pairs (lower index first).
-using FiberPairs = std::set<std::pair<int, int>>;
 
 // Updates `bridges` (moves, ruptures, merges; new bridges if form_new) at state q of `dry` at F; returns the counts.
 // Bridges between `frozen` fiber pairs are kept unchanged and such pairs get no new bridges. settled: q is an

@@ -29,12 +29,21 @@ void grow_region(const WetEnergy& W, std::vector<char>& in, int hops);
 // The flagged nodes split into parts joined by elements (nodes of distinct parts share no element); each sorted.
 std::vector<std::vector<int>> region_parts(const WetEnergy& W, const ElementIncidence& inc, const std::vector<char>& in);
 
+// Every node's displacement and position at a state q (NetworkEnergy::displacements, positions), computed once and
+// shared by the parts of one region: a part's evaluations rewrite its own nodes' entries only, which no other part's
+// elements read, so parts solved one after another need no copy each (at 1e4 fibers a copy costs as much as
+// evaluating a small part).
+struct RegionState {
+    RegionState(const WetEnergy& W, const Eigen::VectorXd& q);
+    Eigen::VectorXd u, x;
+};
+
 class WetRegion : public Objective {
 public:
-    // W's energy as a function of the free coordinates of `nodes`; the other nodes keep their positions in q. Elements
-    // with no node in the region are left out: their energy is constant here, so value() is W's energy less a
-    // constant, and gradient and Hessian are W's restricted to the region's coordinates.
-    WetRegion(const WetEnergy& W, const Eigen::VectorXd& q, const std::vector<int>& nodes, const ElementIncidence& inc);
+    // W's energy as a function of the free coordinates of `nodes`; the other nodes stay where `state` has them (at q).
+    // Elements with no node in the region are left out: their energy is constant here, so value() is W's energy less
+    // a constant, and gradient and Hessian are W's restricted to the region's coordinates.
+    WetRegion(const WetEnergy& W, RegionState& state, const std::vector<int>& nodes, const ElementIncidence& inc);
 
     int size() const override { return static_cast<int>(dofs_.size()); }
     double value(const Eigen::VectorXd& qa) override { return eval(qa, nullptr, nullptr, false); }
@@ -53,9 +62,7 @@ private:
     double eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd);
 
     const WetEnergy& W_;
-    // Every node's displacement and position at q (NetworkEnergy::displacements, positions); an evaluation rewrites
-    // the region's entries only, so it costs the region's size.
-    Eigen::VectorXd u_, x_;
+    Eigen::VectorXd &u_, &x_;  // the shared state; an evaluation rewrites the region's entries only
     std::vector<int> dofs_, dof_node_;           // region coordinate -> coordinate of W, and its node's u_ index
     std::vector<int> segs_, hinges_, bridges_;  // elements with a node in the region
     // Per element: region index of each local coordinate (-1: held), and the Hessian value slot of each local pair
