@@ -459,19 +459,24 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         // bit the dry result). After a local round this is the whole network's gradient against the region's
         // accepted one, so stable still means an equilibrium of every coordinate.
         bool equilibrium = false;
-        double gmax = 0, E_full = 0;
+        double gmax = 0;
         Eigen::VectorXd g;
         if (r.last.converged() || use_local) {
             next = std::make_unique<WetEnergy>(dry, F, bridges, params);
             WetEnergy& Wn = *next;
-            E_full = Wn.gradient(q, g);
+            Wn.gradient(q, g);
             gmax = g.size() ? g.cwiseAbs().maxCoeff() : 0.0;
             equilibrium = r.last.converged() && gmax <= r.last.grad_max * (1 + 1e-9);
+            // After a local round the set was updated only where nodes moved, but a rule that depends on the state
+            // being an equilibrium (the rupture of nearly parallel pairs out of contact) applies everywhere: a global
+            // round (no Newton step at an equilibrium, then a full update) decides.
+            const bool confirm = local && equilibrium;
+            if (confirm) equilibrium = false;
             // The next round: local on the part of the network that needs it, if that part is small enough, else
             // global. That part: the nodes with |g| above local_threshold x max|g| (and tol), and those of the bridges
             // this round changed (their torques are new), grown by local_hops elements.
             region.clear();
-            if (use_local && !equilibrium && !failed_local && g.size() > 0) {
+            if (use_local && !equilibrium && !confirm && !failed_local && g.size() > 0) {
                 std::vector<char> hot = nodes_above(dry, g, std::max(restore.saved.tol, opt.local_threshold * gmax));
                 std::vector<std::array<int, 7>> changed;
                 std::set_symmetric_difference(history.back().begin(), history.back().end(), sig.begin(), sig.end(),
@@ -489,7 +494,6 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
                 if (n_hot > 0 && n_hot <= opt.local_fraction * static_cast<double>(g.size())) region.swap(hot);
             }
         }
-        if (local && equilibrium) r.last.energy = E_full, r.last.grad_max = gmax;  // the whole network's
         r.seconds_events += now() - t0;
         if (opt.verbose)
             std::fprintf(stderr,

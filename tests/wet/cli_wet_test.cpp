@@ -25,6 +25,7 @@ TEST_CASE("cli wet: a small run writes its documented outputs", "[wet][cli]") {
     const std::string j = slurp(out + "/summary.json");
     CHECK(j.find("\"capillary\"") != std::string::npos);
     CHECK(j.find("\"stable\"") != std::string::npos);
+    CHECK(j.find("\"local_rounds\": 0") != std::string::npos);  // beta = 0: one global solve
     CHECK(j.find("\"complete\": true") != std::string::npos);  // false in the copies written between betas
     CHECK(slurp(out + "/sweep.csv").rfind("beta,status,bridges", 0) == 0);
     // Progress on stderr by default: a line per beta and per active-set round; none with --quiet.

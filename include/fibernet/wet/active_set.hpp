@@ -23,6 +23,10 @@
 // but on those pairs (counted: cycles_broken, frozen_pairs). A solve that
 // hits its iteration limit is not a failure: the set is updated and the next round continues from there. While the
 // set keeps changing, rounds are cut at round_iterations on purpose (events interleaved with the solve).
+// Local rounds (local_fraction > 0, beta > 0): when the part of the network that needs a solve is small, a round
+// solves only that part, each connected piece on its own with the rest held (wet_region.hpp), and updates the set only
+// where nodes moved. The whole network's gradient is checked after every round, and only a global round declares the
+// set stable (a local round at an equilibrium, or one that changes nothing, hands the next round to the whole network).
 #include <Eigen/Core>
 #include <set>
 #include <string>
