@@ -19,10 +19,10 @@ WetEnergy::WetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, std::ve
 // (wet_region.hpp), never builds them.
 const Eigen::SparseMatrix<double>& WetEnergy::hessian_pattern() const {
     if (pattern_built_) return pattern_;
-    pattern_built_ = true;
     const NetworkEnergy& dry = dry_;
     if (!active()) {
         pattern_ = dry.hessian_pattern();
+        pattern_built_ = true;
         return pattern_;
     }
     // Union pattern, column by column.
@@ -68,6 +68,7 @@ const Eigen::SparseMatrix<double>& WetEnergy::hessian_pattern() const {
                 if (r >= 0 && c >= 0 && r <= c) bridge_slots_[256 * k + 16 * a + b] = slot(r, c);
             }
     dry_H_ = P;
+    pattern_built_ = true;  // only now: a build that threw is tried again, not half used
     return pattern_;
 }
 

@@ -93,12 +93,13 @@ std::vector<std::vector<int>> region_parts(const WetEnergy& W, const ElementInci
     std::vector<std::vector<int>> parts;
     std::vector<int> stack;
     for (int s = 0; s < nn; ++s) {
-        if (!in[s] || part[s] >= 0) continue;
+        if (!in[s] || part[s] >= 0 || W.dry().dof(s, 0) < 0) continue;
         const int id = static_cast<int>(parts.size());
         parts.emplace_back();
         part[s] = id, stack.assign(1, s);
+        // A node without coordinates (fixed) never moves, so it joins nothing.
         auto visit = [&](int v) {
-            if (v >= 0 && in[v] && part[v] < 0) part[v] = id, stack.push_back(v);
+            if (v >= 0 && in[v] && part[v] < 0 && W.dry().dof(v, 0) >= 0) part[v] = id, stack.push_back(v);
         };
         while (!stack.empty()) {
             const int v = stack.back();

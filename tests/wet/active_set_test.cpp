@@ -267,7 +267,7 @@ TEST_CASE("active set: a bridge set that repeats is reported as cycling", "[wet]
     const ActiveSetResult r3 = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver3, q3, opt3);
     CHECK(r3.cycles_broken == 1);
     CHECK(!r3.stable);
-    CHECK(r3.message == "no stable bridge set after 3 rounds (last solve: converged)");
+    CHECK(r3.message == "no stable bridge set after 3 rounds (3 global; last solve: converged)");
 }
 
 TEST_CASE("active set: a cycle after cut rounds that changed nothing is named and broken", "[wet][events]") {

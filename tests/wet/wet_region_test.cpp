@@ -169,6 +169,21 @@ TEST_CASE("wet relaxation: local rounds end at an equilibrium of the whole netwo
     CHECK(W.gradient(q, g) == Approx(r.last.energy).epsilon(1e-12));
     CHECK(g.cwiseAbs().maxCoeff() <= so.tol);
     std::vector<Bridge> b = r.bridges;
+    // max_rounds bounds the global rounds only: the same run with max_rounds = its global rounds ends the same; one
+    // less ends unstable, saying so.
+    const int global = r.rounds - r.local_rounds;
+    for (int cap : {global, global - 1}) {
+        ActiveSetOptions o2 = opt;
+        o2.max_rounds = cap;
+        Eigen::VectorXd q2 = e.dofs(m.x);
+        auto s2 = make_solver("newton", so);
+        const ActiveSetResult r2 = relax_wet(e, Eigen::Matrix2d::Identity(), p, initial, *s2, q2, o2);
+        INFO("max_rounds " << cap << ": " << r2.message);
+        CHECK(r2.stable == (cap == global));
+        CHECK(r2.rounds - r2.local_rounds == cap);
+        if (cap == global) CHECK(r2.rounds == r.rounds);
+        else CHECK(r2.message.find("(" + std::to_string(cap) + " global;") != std::string::npos);
+    }
     CHECK(static_cast<int>(r.frozen.size()) == r.frozen_pairs);
     CHECK(update_bridges(e, q, Eigen::Matrix2d::Identity(), b, {}, &r.frozen).total() == 0);  // but on frozen pairs
 }

@@ -44,7 +44,8 @@ struct WetEvents {
 };
 
 struct ActiveSetOptions {
-    int max_rounds = 1000;      // a cut round is only round_iterations solver iterations
+    int max_rounds = 1000;      // global rounds (a cut round is only round_iterations solver iterations); local rounds
+                                // are bounded by 10 x max_rounds rounds in all
     // > 0: while the set keeps changing, a round's solve stops after this many solver iterations and the set is
     // updated (events interleaved with the solve: new crossings get their bridges while the fibers still move); a
     // round that leaves the set unchanged, or returns to an earlier set, lifts the cap for the next. 0: every round is
@@ -79,12 +80,12 @@ struct ActiveSetResult {
     SolveResult last;              // the last solve (its status says whether q is an equilibrium of the final set)
     WetEvents events;              // summed over rounds
     std::vector<WetEvents> per_round;
-    int rounds = 0, solver_iterations = 0, factorizations = 0;
+    int rounds = 0, solver_iterations = 0, factorizations = 0;  // rounds: global and local
     int local_rounds = 0;          // rounds solved on a region of the network (ActiveSetOptions::local_fraction)
     int local_iterations = 0;      // solver iterations in those rounds, summed over their parts
     double seconds_local = 0;      // solve time in those rounds (part of seconds_solve)
     SolveTimings timings;          // the solver's time split, summed over rounds
-    bool stable = false;           // the last round changed nothing: q is an equilibrium with a consistent set
+    bool stable = false;           // the last round, a global one, changed nothing: q is an equilibrium with a consistent set
     bool cycling = false;          // a bridge set repeated after max_freezes cycles were broken
     int cycles_broken = 0;         // cycles broken by freezing the toggling fiber pairs
     int frozen_pairs = 0;          // fiber pairs whose bridges were frozen

@@ -55,7 +55,7 @@ private:
     std::vector<Bridge> bridges_;
     std::vector<BridgeElement> elements_;
     WetParams params_;
-    // Built on first use (hessian_pattern()).
+    // Built on first use (hessian_pattern()); not thread safe (one WetEnergy per solve).
     mutable bool pattern_built_ = false;
     mutable Eigen::SparseMatrix<double> pattern_, dry_H_;
     mutable std::vector<int> dry_slot_;     // dry pattern value index -> union value index

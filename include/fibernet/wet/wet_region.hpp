@@ -26,7 +26,8 @@ std::vector<char> nodes_above(const NetworkEnergy& dry, const Eigen::VectorXd& g
 // Grows the flagged set `hops` times by whole elements of W (a node joins when it shares a segment, hinge or bridge
 // with a node already in).
 void grow_region(const WetEnergy& W, std::vector<char>& in, int hops);
-// The flagged nodes split into parts joined by elements (nodes of distinct parts share no element); each sorted.
+// The flagged nodes with coordinates split into parts joined by elements (nodes of distinct parts share no element
+// but held ones); each sorted. Fixed nodes never move and join nothing.
 std::vector<std::vector<int>> region_parts(const WetEnergy& W, const ElementIncidence& inc, const std::vector<char>& in);
 
 // Every node's displacement and position at a state q (NetworkEnergy::displacements, positions), computed once and
