@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "fibernet/energy/bend.hpp"
+#include "fibernet/energy/sparse_pattern.hpp"
 
 namespace fibernet {
 
@@ -12,15 +13,6 @@ namespace {
 // Local upper-triangular pairs (a <= b) of an m x m element block, in row-major order.
 template <int M>
 constexpr int n_upper() { return M * (M + 1) / 2; }
-
-int find_slot(const Eigen::SparseMatrix<double>& P, int r, int c) {
-    if (r > c) std::swap(r, c);
-    const int* inner = P.innerIndexPtr();
-    const int b = P.outerIndexPtr()[c], e = P.outerIndexPtr()[c + 1];
-    const int* it = std::lower_bound(inner + b, inner + e, r);
-    if (it == inner + e || *it != r) throw std::logic_error("hessian pattern lacks an entry");
-    return static_cast<int>(it - inner);
-}
 
 // Slots for an element on nodes[0..K-1] (2K local coordinates).
 template <int K>
@@ -32,7 +24,7 @@ void element_slots(const int* nodes, const std::vector<int>& dof, const Eigen::S
     for (int a = 0; a < 2 * K; ++a)
         for (int b = a; b < 2 * K; ++b) {
             const int r = dof[2 * nodes[a / 2] + a % 2], c = dof[2 * nodes[b / 2] + b % 2];
-            out[s++] = (r < 0 || c < 0) ? -1 : find_slot(P, r, c);
+            out[s++] = (r < 0 || c < 0) ? -1 : pattern_slot(P, std::min(r, c), std::max(r, c));
         }
 }
 

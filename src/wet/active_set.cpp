@@ -112,35 +112,31 @@ void near_pairs(const Model& m, const SegGeom& g, const Eigen::Matrix2d& B, doub
         visit(a, b, Pb);
     };
     const bool all = nc[0] == 1 && nc[1] == 1;
+    // Calls f(b) for every segment b in the cells around cell (cx, cy) (wrapped in a periodic box).
+    auto around = [&](int cx, int cy, auto f) {
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                if (all && (dx || dy)) continue;
+                int X = cx + dx, Y = cy + dy;
+                if (m.box.periodic) X = (X + nc[0]) % nc[0], Y = (Y + nc[1]) % nc[1];
+                else if (X < 0 || Y < 0 || X >= nc[0] || Y >= nc[1]) continue;
+                for (int b : cell[X + nc[0] * Y]) f(b);
+            }
+    };
     if (only) {  // from the flagged segments alone, each pair once (a flagged pair from its lower index)
-        for (int a = 0; a < ns; ++a) {
-            if (!(*only)[a]) continue;
-            const int cx = cell_of(U[a], 0), cy = cell_of(U[a], 1);
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    if (all && (dx || dy)) continue;
-                    int X = cx + dx, Y = cy + dy;
-                    if (m.box.periodic) X = (X + nc[0]) % nc[0], Y = (Y + nc[1]) % nc[1];
-                    else if (X < 0 || Y < 0 || X >= nc[0] || Y >= nc[1]) continue;
-                    for (int b : cell[X + nc[0] * Y])
-                        if (b != a && !((*only)[b] && b < a)) test(std::min(a, b), std::max(a, b));
-                }
-        }
+        for (int a = 0; a < ns; ++a)
+            if ((*only)[a])
+                around(cell_of(U[a], 0), cell_of(U[a], 1), [&](int b) {
+                    if (b != a && !((*only)[b] && b < a)) test(std::min(a, b), std::max(a, b));
+                });
         return;
     }
     for (int cy = 0; cy < nc[1]; ++cy)
         for (int cx = 0; cx < nc[0]; ++cx)
-            for (int a : cell[cx + nc[0] * cy]) {
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        if (all && (dx || dy)) continue;
-                        int X = cx + dx, Y = cy + dy;
-                        if (m.box.periodic) X = (X + nc[0]) % nc[0], Y = (Y + nc[1]) % nc[1];
-                        else if (X < 0 || Y < 0 || X >= nc[0] || Y >= nc[1]) continue;
-                        for (int b : cell[X + nc[0] * Y])
-                            if (b > a) test(a, b);
-                    }
-            }
+            for (int a : cell[cx + nc[0] * cy])
+                around(cx, cy, [&](int b) {
+                    if (b > a) test(a, b);
+                });
 }
 
 bool intersects(const Eigen::Vector2d& Pa, const Eigen::Vector2d& Da, const Eigen::Vector2d& Pb, const Eigen::Vector2d& Db) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "fibernet/energy/sparse_pattern.hpp"
 #include "fibernet/util/parallel.hpp"
 
 namespace fibernet {
@@ -38,25 +39,8 @@ const Eigen::SparseMatrix<double>& WetEnergy::hessian_pattern() const {
                 const int r = local_dof(e, a), c = local_dof(e, b);
                 if (r >= 0 && c >= 0 && r <= c) cols[c].push_back(r);
             }
-    std::vector<int> outer(n + 1, 0), inner;
-    for (int c = 0; c < n; ++c) {
-        auto& v = cols[c];
-        std::sort(v.begin(), v.end());
-        v.erase(std::unique(v.begin(), v.end()), v.end());
-        inner.insert(inner.end(), v.begin(), v.end());
-        outer[c + 1] = static_cast<int>(inner.size());
-    }
-    std::vector<double> zeros(inner.size(), 0.0);
-    pattern_ = Eigen::Map<const Eigen::SparseMatrix<double>>(n, n, static_cast<Eigen::Index>(inner.size()), outer.data(),
-                                                            inner.data(), zeros.data());
-    pattern_.makeCompressed();
-    auto slot = [&](int r, int c) {
-        const int* in = pattern_.innerIndexPtr();
-        const int b = pattern_.outerIndexPtr()[c], e = pattern_.outerIndexPtr()[c + 1];
-        const int* it = std::lower_bound(in + b, in + e, r);
-        if (it == in + e || *it != r) throw std::logic_error("wet pattern lacks an entry");
-        return static_cast<int>(it - in);
-    };
+    pattern_ = pattern_from_columns(n, cols);
+    auto slot = [&](int r, int c) { return pattern_slot(pattern_, r, c); };
     dry_slot_.reserve(P.nonZeros());
     for (int c = 0; c < n; ++c)
         for (Eigen::SparseMatrix<double>::InnerIterator it(P, c); it; ++it) dry_slot_.push_back(slot(static_cast<int>(it.row()), c));

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "fibernet/energy/sparse_pattern.hpp"
+
 namespace fibernet {
 
 namespace {
@@ -128,9 +130,9 @@ WetRegion::WetRegion(const WetEnergy& W, RegionState& state, const std::vector<i
     std::vector<int> order(nodes);
     std::sort(order.begin(), order.end());
     auto local = [&](int node, int c) -> int {
-        const int d = dry.dof(node, c);
-        if (d < 0 || !std::binary_search(order.begin(), order.end(), node)) return -1;
-        return 2 * static_cast<int>(std::lower_bound(order.begin(), order.end(), node) - order.begin()) + c;
+        const auto it = std::lower_bound(order.begin(), order.end(), node);
+        if (dry.dof(node, c) < 0 || it == order.end() || *it != node) return -1;
+        return 2 * static_cast<int>(it - order.begin()) + c;
     };
     // Coordinates: 2 per node in sorted order, fixed ones (no coordinate) left out below by compaction.
     std::vector<int> compact(2 * order.size(), -1);
@@ -178,29 +180,15 @@ WetRegion::WetRegion(const WetEnergy& W, RegionState& state, const std::vector<i
                 }
     };
     collect(seg_idx_, 4), collect(hinge_idx_, 6), collect(bridge_idx_, 16);
-    std::vector<int> outer(n + 1, 0), inner;
-    for (int c = 0; c < n; ++c) {
-        auto& v = cols[c];
-        if (v.empty() || v.back() != c) v.push_back(c);  // a diagonal entry for every coordinate
-        std::sort(v.begin(), v.end());
-        v.erase(std::unique(v.begin(), v.end()), v.end());
-        inner.insert(inner.end(), v.begin(), v.end());
-        outer[c + 1] = static_cast<int>(inner.size());
-    }
-    std::vector<double> zeros(inner.size(), 0.0);
-    pattern_ = Eigen::Map<const Eigen::SparseMatrix<double>>(n, n, static_cast<Eigen::Index>(inner.size()), outer.data(),
-                                                            inner.data(), zeros.data());
-    pattern_.makeCompressed();
+    for (int c = 0; c < n; ++c) cols[c].push_back(c);  // a diagonal entry for every coordinate
+    pattern_ = pattern_from_columns(n, cols);
     auto slots = [&](const std::vector<int>& idx, int M, std::vector<int>& out) {
         out.assign(idx.size() / M * M * M, -1);
         for (size_t e = 0; e < idx.size() / M; ++e)
             for (int a = 0; a < M; ++a)
                 for (int b = 0; b < M; ++b) {
                     const int r = idx[e * M + a], c = idx[e * M + b];
-                    if (r < 0 || c < 0 || r > c) continue;
-                    const int* in = pattern_.innerIndexPtr();
-                    const int* it = std::lower_bound(in + pattern_.outerIndexPtr()[c], in + pattern_.outerIndexPtr()[c + 1], r);
-                    out[e * M * M + a * M + b] = static_cast<int>(it - in);
+                    if (r >= 0 && c >= 0 && r <= c) out[e * M * M + a * M + b] = pattern_slot(pattern_, r, c);
                 }
     };
     slots(seg_idx_, 4, seg_slot_), slots(hinge_idx_, 6, hinge_slot_), slots(bridge_idx_, 16, bridge_slot_);
