@@ -313,7 +313,11 @@ void register_wet(CLI::App& app) {
                  {"solver_iterations", r.active.solver_iterations},
                  {"seconds",
                   {{"dry", r.seconds_dry}, {"wet_solve", r.seconds_wet_solve}, {"events", r.seconds_events},
-                   {"pores", r.seconds_pores}, {"moduli", r.seconds_moduli}}}});
+                   {"pores", r.seconds_pores}, {"moduli", r.seconds_moduli},
+                   // parts: of wet_solve, the local rounds and, in them, building their pieces; of events, the bridge
+                   // update and the next set's gradient
+                   {"wet_local", r.active.seconds_local}, {"local_setup", r.active.seconds_local_setup},
+                   {"bridge_update", r.active.seconds_update}, {"gradient", r.active.seconds_gradient}}}});
             // Finished betas survive an interrupt: the tables and summary.json (complete: false) are rewritten
             // (atomically) after each one; the pictures and stdout come at the end.
             if (!w->out.empty() && k + 1 < betas.size()) {

@@ -66,7 +66,9 @@ CholmodLLT& NewtonSolver::factorization_for(const Eigen::SparseMatrix<double>& H
         auto t0 = Clock::now();
         llt_ = std::make_unique<CholmodLLT>();
         analyzed_ = H;
-        if (H.rows() > 0) llt_->analyze(H);
+        // With the LDL^T rung the LL^T factorization is only a fallback: analyzed on first use (CholmodLLT::factorize),
+        // which on wet networks with many small regions is often never.
+        if (H.rows() > 0 && !opt_.ldl) llt_->analyze(H);
         ldl_.reset();  // analyzed on first use (SolverOptions::ldl)
         if (seconds) *seconds = since(t0);
     }
@@ -279,8 +281,10 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         shifts_.push_back(rung <= 2 ? shift : 0.0);
         if (opt_.verbose)
             std::fprintf(stderr, "newton %4d  E = %.15e  max|g| = %.3e  floor %.1e  rung %d%s  shift %.2e  alpha %.3e\n", it,
-                         fq, gmax, floor, rung, step_ldl ? " (LDL^T)" : retried ? " (after LDL^T)" : "", shift,
-                         accepted ? alpha : 0.0);
+                         fq, gmax, floor, rung,
+                         step_ldl ? (" (LDL^T, " + std::to_string(ldl->negative_pivots()) + " negative pivots)").c_str()
+                                  : retried ? " (after LDL^T)" : "",
+                         shift, accepted ? alpha : 0.0);
         if (!accepted) {
             r.status = SolveStatus::LineSearchFailed;
             r.message = "no acceptable step along a descent direction at iteration " + std::to_string(it);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -185,6 +186,8 @@ std::vector<Bridge> segment_contacts(const Model& m, const Eigen::VectorXd& x, c
     const double smax = std::sin(angle_deg * M_PI / 180);
     std::vector<Bridge> out;
     near_pairs(m, g, B, distance, only, [&](int a, int b, const Eigen::Vector2d& Pb) {
+        // The angle first: it rejects most pairs before the four point-segment distances.
+        if (std::abs(cross2(g.D[a], g.D[b])) / (g.D[a].norm() * g.D[b].norm()) > smax) return;
         const Contact c = contact(g.P[a], g.D[a], Pb, g.D[b]);
         const double lmin = std::min(g.D[a].norm(), g.D[b].norm());
         if (c.sin_angle <= smax && c.distance <= distance && c.overlap >= 0.5 * lmin) {
@@ -287,15 +290,6 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
         else ++ev.merged;
     }
     if (!opt.form_new) return ev;
-    // Existing bridges by fiber pair and image: a crossing on or next to a bridged pair is that bridge's (a crossing
-    // at a node is found on either side of it); a contact needs both its segments free towards the other fiber.
-    std::map<std::array<int, 4>, std::vector<std::pair<int, int>>> near;
-    std::set<std::array<int, 3>> partnered;  // (fiber, segment, other fiber) holding a bridge
-    auto note = [&](const Bridge& b) {
-        near[{b.f1, b.f2, b.image.x(), b.image.y()}].push_back({b.k1, b.k2});
-        partnered.insert({b.f1, b.k1, b.f2}), partnered.insert({b.f2, b.k2, b.f1});
-    };
-    for (const Bridge& b : bridges) note(b);
     // Only segments with a node that moved can cross or touch anything new.
     std::vector<char> seg_moved;
     if (moved) {
@@ -306,7 +300,27 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
         }
     }
     const std::vector<char>* only = moved ? &seg_moved : nullptr;
-    for (const Bridge& c : segment_crossings(m, x, B, only)) {
+    const std::vector<Bridge> crossings = segment_crossings(m, x, B, only);
+    const std::vector<Bridge> contacts = segment_contacts(m, x, B, rc, opt.contact_angle_deg, only);
+    // Existing bridges by fiber pair and image: a crossing on or next to a bridged pair is that bridge's (a crossing
+    // at a node is found on either side of it); a contact needs both its segments free towards the other fiber. Only
+    // the fiber pairs of the candidates are looked up, so only their bridges are indexed (a local round's candidates
+    // are few, the bridges of a 1e4-fiber network ~4e4).
+    std::vector<std::pair<int, int>> pairs;
+    for (const auto* list : {&crossings, &contacts})
+        for (const Bridge& c : *list) pairs.push_back({std::min(c.f1, c.f2), std::max(c.f1, c.f2)});
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+    std::map<std::array<int, 4>, std::vector<std::pair<int, int>>> near;
+    std::set<std::array<int, 3>> partnered;  // (fiber, segment, other fiber) holding a bridge
+    auto note = [&](const Bridge& b) {
+        near[{b.f1, b.f2, b.image.x(), b.image.y()}].push_back({b.k1, b.k2});
+        partnered.insert({b.f1, b.k1, b.f2}), partnered.insert({b.f2, b.k2, b.f1});
+    };
+    for (const Bridge& b : bridges)
+        if (std::binary_search(pairs.begin(), pairs.end(), std::make_pair(std::min(b.f1, b.f2), std::max(b.f1, b.f2))))
+            note(b);
+    for (const Bridge& c : crossings) {
         auto& v = near[{c.f1, c.f2, c.image.x(), c.image.y()}];
         const bool known = std::any_of(v.begin(), v.end(), [&](const std::pair<int, int>& h) {
             return std::abs(h.first - c.k1) <= 1 && std::abs(h.second - c.k2) <= 1;
@@ -330,7 +344,7 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
         bridges.push_back(c);
         ++ev.formed;
     }
-    for (const Bridge& c : segment_contacts(m, x, B, rc, opt.contact_angle_deg, only)) {
+    for (const Bridge& c : contacts) {
         if (partnered.count({c.f1, c.k1, c.f2}) || partnered.count({c.f2, c.k2, c.f1}) || is_frozen(c.f1, c.f2)) continue;
         note(c);
         bridges.push_back(c);
@@ -385,6 +399,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
     // Local rounds were designed and measured with Newton (docs/wet.md, "Local rounds").
     const bool use_local = opt.local_fraction > 0 && params.beta > 0 && solver.name() == "newton";
     std::vector<char> region;  // non-empty: the next round is local, on these nodes
+    ElementIncidence inc;      // of the energy the next local round solves (segment and hinge rows built once)
     std::unique_ptr<WetEnergy> next;
     // max_rounds bounds the global rounds; local ones are cheap and many (1253 of 1341 at 1e4 fibers), bounded by
     // 10 x max_rounds in all.
@@ -404,14 +419,19 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         if (local) {
             // Each part of the region on its own (wet_region.hpp): its own line search and convergence. The round's
             // result: iterations summed, the worst status (a failure, else an iteration limit), the largest max|g|.
-            const ElementIncidence inc = element_incidence(W);
+            // Usually built for W after the last round, when the region was chosen.
+            if (inc.seg_start.empty()) inc = element_incidence(W);
+            else if (inc.bridges_of != W.elements().data()) update_bridge_incidence(W, inc);
+            RegionState state(W, q);
             const auto parts = region_parts(W, inc, region);
+            r.seconds_local_setup += now() - t0;
             so.warm_start = restore.saved.warm_start;  // each part adapts its own shift
             SolveResult all;
             all.status = SolveStatus::Converged, all.solver = solver.name();
-            RegionState state(W, q);
             for (const auto& nodes : parts) {
+                const double ts = now();
                 WetRegion R(W, state, nodes, inc);
+                r.seconds_local_setup += now() - ts;
                 if (R.size() == 0) continue;
                 region_size += R.size(), ++region_parts_n;
                 Eigen::VectorXd qa = R.restrict(q);
@@ -452,6 +472,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         const WetEvents ev = update_bridges(dry, q, F, bridges, opt, &frozen, r.last.converged(), local ? &moved_nodes : nullptr);
         r.per_round.push_back(ev);
         Signature sig = signature(bridges);
+        r.seconds_update += now() - t0;
         r.events.moves += ev.moves, r.events.ruptures += ev.ruptures;
         r.events.formed += ev.formed, r.events.merged += ev.merged, r.events.locked += ev.locked;
         // Moves, locks and fade-out ruptures leave the energy unchanged near q: if the updated set's gradient at q is
@@ -462,10 +483,12 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         double gmax = 0;
         Eigen::VectorXd g;
         if (r.last.converged() || use_local) {
+            const double tg = now();
             next = std::make_unique<WetEnergy>(dry, F, bridges, params);
             WetEnergy& Wn = *next;
             Wn.gradient(q, g);
             gmax = g.size() ? g.cwiseAbs().maxCoeff() : 0.0;
+            r.seconds_gradient += now() - tg;
             equilibrium = r.last.converged() && gmax <= r.last.grad_max * (1 + 1e-9);
             // After a local round the set was updated only where nodes moved, but a rule that depends on the state
             // being an equilibrium (the rupture of nearly parallel pairs out of contact) applies everywhere: a global
@@ -487,7 +510,9 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
                     for (int node : resolve(dry.model(), b).node)
                         if (node >= 0) hot[node] = 1;
                 }
-                grow_region(Wn, hot, opt.local_hops);
+                if (inc.seg_start.empty()) inc = element_incidence(Wn);
+                else update_bridge_incidence(Wn, inc);
+                grow_region(Wn, inc, hot, opt.local_hops);
                 int n_hot = 0;
                 for (int i = 0; i < dry.model().num_nodes(); ++i)
                     n_hot += hot[i] ? (dry.dof(i, 0) >= 0) + (dry.dof(i, 1) >= 0) : 0;

@@ -7,21 +7,27 @@
 
 namespace fibernet {
 
+
 namespace {
-// Calls f(nodes, count) for every element of W: segments, hinges and bridges (absent bridge nodes are -1).
-template <class F>
-void for_each_element(const WetEnergy& W, F f) {
-    const Model& m = W.dry().model();
-    for (const Segment& s : m.segments) {
-        const int n[2] = {s.i, s.j};
-        f(n, 2);
+// Counting sort of (node, element) pairs into compressed rows; nodes_of(e, k) returns element e's k nodes (-1: none).
+template <class NodesOf>
+void build_rows(int nn, int ne, NodesOf nodes_of, std::vector<int>& start, std::vector<int>& list) {
+    start.assign(nn + 1, 0);
+    for (int e = 0; e < ne; ++e) {
+        int k = 0;
+        const int* n = nodes_of(e, k);
+        for (int a = 0; a < k; ++a)
+            if (n[a] >= 0 && std::find(n, n + a, n[a]) == n + a) ++start[n[a] + 1];
     }
-    for (const Hinge& h : m.hinges) {
-        const int n[3] = {h.i, h.j, h.k};
-        f(n, 3);
+    for (int i = 0; i < nn; ++i) start[i + 1] += start[i];
+    list.resize(start[nn]);
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (int e = 0; e < ne; ++e) {
+        int k = 0;
+        const int* n = nodes_of(e, k);
+        for (int a = 0; a < k; ++a)
+            if (n[a] >= 0 && std::find(n, n + a, n[a]) == n + a) list[fill[n[a]]++] = e;
     }
-    if (W.params().beta != 0)
-        for (const BridgeElement& e : W.elements()) f(e.node, 8);
 }
 }  // namespace
 
@@ -29,40 +35,26 @@ ElementIncidence element_incidence(const WetEnergy& W) {
     const Model& m = W.dry().model();
     const int nn = m.num_nodes();
     ElementIncidence inc;
-    // Counting sort of (node, element) pairs into compressed rows.
-    auto build = [&](int ne, auto nodes_of, std::vector<int>& start, std::vector<int>& list) {
-        start.assign(nn + 1, 0);
-        for (int e = 0; e < ne; ++e) {
-            int k = 0;
-            const int* n = nodes_of(e, k);
-            for (int a = 0; a < k; ++a)
-                if (n[a] >= 0 && std::find(n, n + a, n[a]) == n + a) ++start[n[a] + 1];
-        }
-        for (int i = 0; i < nn; ++i) start[i + 1] += start[i];
-        list.resize(start[nn]);
-        std::vector<int> fill(start.begin(), start.end() - 1);
-        for (int e = 0; e < ne; ++e) {
-            int k = 0;
-            const int* n = nodes_of(e, k);
-            for (int a = 0; a < k; ++a)
-                if (n[a] >= 0 && std::find(n, n + a, n[a]) == n + a) list[fill[n[a]]++] = e;
-        }
-    };
-    std::vector<int> buf(3);
-    build(static_cast<int>(m.segments.size()), [&](int e, int& k) {
+    int buf[3];
+    build_rows(nn, static_cast<int>(m.segments.size()), [&](int e, int& k) {
         buf[0] = m.segments[e].i, buf[1] = m.segments[e].j, k = 2;
-        return buf.data();
+        return static_cast<const int*>(buf);
     }, inc.seg_start, inc.seg);
-    build(static_cast<int>(m.hinges.size()), [&](int e, int& k) {
+    build_rows(nn, static_cast<int>(m.hinges.size()), [&](int e, int& k) {
         buf[0] = m.hinges[e].i, buf[1] = m.hinges[e].j, buf[2] = m.hinges[e].k, k = 3;
-        return buf.data();
+        return static_cast<const int*>(buf);
     }, inc.hinge_start, inc.hinge);
-    const bool wet = W.params().beta != 0;
-    build(wet ? static_cast<int>(W.elements().size()) : 0, [&](int e, int& k) {
-        k = 8;
-        return W.elements()[e].node;
-    }, inc.bridge_start, inc.bridge);
+    update_bridge_incidence(W, inc);
     return inc;
+}
+
+void update_bridge_incidence(const WetEnergy& W, ElementIncidence& inc) {
+    const bool wet = W.params().beta != 0;
+    build_rows(W.dry().model().num_nodes(), wet ? static_cast<int>(W.elements().size()) : 0, [&](int e, int& k) {
+        k = 8;
+        return static_cast<const int*>(W.elements()[e].node);
+    }, inc.bridge_start, inc.bridge);
+    inc.bridges_of = W.elements().data();
 }
 
 std::vector<char> nodes_above(const NetworkEnergy& dry, const Eigen::VectorXd& g, double threshold) {
@@ -74,17 +66,33 @@ std::vector<char> nodes_above(const NetworkEnergy& dry, const Eigen::VectorXd& g
     return in;
 }
 
-void grow_region(const WetEnergy& W, std::vector<char>& in, int hops) {
-    for (int h = 0; h < hops; ++h) {
-        std::vector<char> next = in;
-        for_each_element(W, [&](const int* n, int k) {
-            bool any = false;
-            for (int a = 0; a < k && !any; ++a) any = n[a] >= 0 && in[n[a]];
-            if (any)
-                for (int a = 0; a < k; ++a)
-                    if (n[a] >= 0) next[n[a]] = 1;
-        });
-        in.swap(next);
+namespace {
+// Calls f(v) for every node v sharing an element of W with node u (u itself included).
+template <class F>
+void for_each_neighbour(const WetEnergy& W, const ElementIncidence& inc, int u, F f) {
+    const Model& m = W.dry().model();
+    for (int k = inc.seg_start[u]; k < inc.seg_start[u + 1]; ++k) f(m.segments[inc.seg[k]].i), f(m.segments[inc.seg[k]].j);
+    for (int k = inc.hinge_start[u]; k < inc.hinge_start[u + 1]; ++k)
+        f(m.hinges[inc.hinge[k]].i), f(m.hinges[inc.hinge[k]].j), f(m.hinges[inc.hinge[k]].k);
+    for (int k = inc.bridge_start[u]; k < inc.bridge_start[u + 1]; ++k)
+        for (int a = 0; a < 8; ++a)
+            if (W.elements()[inc.bridge[k]].node[a] >= 0) f(W.elements()[inc.bridge[k]].node[a]);
+}
+}  // namespace
+
+void grow_region(const WetEnergy& W, const ElementIncidence& inc, std::vector<char>& in, int hops) {
+    // Breadth first, one hop per layer: a layer's nodes are those of the elements at the last layer's nodes.
+    std::vector<int> layer;
+    for (int i = 0; i < static_cast<int>(in.size()); ++i)
+        if (in[i]) layer.push_back(i);
+    std::vector<int> next;
+    for (int h = 0; h < hops && !layer.empty(); ++h) {
+        next.clear();
+        for (int u : layer)
+            for_each_neighbour(W, inc, u, [&](int v) {
+                if (!in[v]) in[v] = 1, next.push_back(v);
+            });
+        layer.swap(next);
     }
 }
 
@@ -107,12 +115,7 @@ std::vector<std::vector<int>> region_parts(const WetEnergy& W, const ElementInci
             const int v = stack.back();
             stack.pop_back();
             parts[id].push_back(v);
-            for (int k = inc.seg_start[v]; k < inc.seg_start[v + 1]; ++k)
-                visit(m.segments[inc.seg[k]].i), visit(m.segments[inc.seg[k]].j);
-            for (int k = inc.hinge_start[v]; k < inc.hinge_start[v + 1]; ++k)
-                visit(m.hinges[inc.hinge[k]].i), visit(m.hinges[inc.hinge[k]].j), visit(m.hinges[inc.hinge[k]].k);
-            for (int k = inc.bridge_start[v]; k < inc.bridge_start[v + 1]; ++k)
-                for (int a = 0; a < 8; ++a) visit(W.elements()[inc.bridge[k]].node[a]);
+            for_each_neighbour(W, inc, v, visit);
         }
         std::sort(parts[id].begin(), parts[id].end());
     }

@@ -150,7 +150,8 @@ TEST_CASE("wet energy: the projected Hessian is positive semidefinite", "[wet][h
 }
 
 TEST_CASE("wet energy: bit for bit the same on any number of threads", "[wet][parallel]") {
-    // Enough bridges (>= 1024) for the parallel element loop, and more than one chunk of 2048.
+    // Enough bridges (>= 1024) for the parallel element loop, and more than two chunks of 1000 (the dry terms run
+    // beside the first).
     const Model m = model_of(mikado(12, 10, 0.5, 4), 10);
     NetworkEnergy dry(m);
     const Eigen::VectorXd q = perturb(dry.dofs(m.x), 0.01, 9);
@@ -158,6 +159,7 @@ TEST_CASE("wet energy: bit for bit the same on any number of threads", "[wet][pa
     p.beta = 0.3;
     WetEnergy W(dry, Eigen::Matrix2d::Identity(), segment_crossings(m, dry.positions(q, Eigen::Matrix2d::Identity()), m.box.B0()), p);
     REQUIRE(W.bridges().size() > 2048);
+    W.set_chunk(1000);
     auto evaluate = [&](int threads, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H) {
         set_thread_count(threads);
         H = W.hessian_pattern();

@@ -65,9 +65,22 @@ void check_region(const Model& m, const Eigen::Matrix2d& F, std::uint64_t seed) 
     CHECK(changed <= R.size());
     CHECK((R.restrict(q2) - qa2).norm() == 0);
 
+    // The incidence of another bridge set, updated from this one's bridge rows, is that set's own.
+    const ElementIncidence inc = element_incidence(W);
+    {
+        WetEnergy W2(dry, F, std::vector<Bridge>(bridges.begin() + bridges.size() / 2, bridges.end()), p);
+        ElementIncidence inc2 = inc;
+        update_bridge_incidence(W2, inc2);
+        const ElementIncidence fresh = element_incidence(W2);
+        CHECK(inc2.seg_start == fresh.seg_start);
+        CHECK(inc2.seg == fresh.seg);
+        CHECK(inc2.hinge == fresh.hinge);
+        CHECK(inc2.bridge_start == fresh.bridge_start);
+        CHECK(inc2.bridge == fresh.bridge);
+        CHECK(inc2.bridge != inc.bridge);
+    }
     // The parts of the region are independent: moved one after another through one shared state, each part's gradient
     // at its own new coordinates is the whole energy's at the final state.
-    const ElementIncidence inc = element_incidence(W);
     const auto parts = region_parts(W, inc, active);
     REQUIRE(parts.size() >= 2);
     RegionState shared(W, q);
@@ -118,7 +131,7 @@ TEST_CASE("wet region: nodes by |g|, grown by whole elements, split into indepen
     auto count = [](const std::vector<char>& v) { return std::count(v.begin(), v.end(), 1); };
     auto grown = [&](double thr, int hops) {
         std::vector<char> in = nodes_above(dry, g, thr);
-        grow_region(W, in, hops);
+        grow_region(W, element_incidence(W), in, hops);
         return in;
     };
     CHECK(count(grown(1e-4, 0)) == 1);

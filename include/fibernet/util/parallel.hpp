@@ -1,6 +1,7 @@
 #pragma once
 // A minimal parallel loop for element evaluations. Callers write each element's result to its own slot and sum the
 // slots in element order afterwards, so results are bit for bit the same for any number of threads.
+#include <atomic>
 #include <cstddef>
 #include <exception>
 #include <thread>
@@ -41,6 +42,48 @@ void parallel_ranges(std::size_t n, int threads, Body body) {
         throw;
     }
     run(0);
+    for (auto& th : pool) th.join();
+    for (auto& e : errors)
+        if (e) std::rethrow_exception(e);
+}
+
+// Calls first() and then body(lo, hi) on blocks of `block` items covering [0, n) on the calling thread, while
+// threads - 1 more threads take blocks from the start: for a task (first) that runs beside a loop whose items the
+// threads share as they come free. Results go to per-item slots, as above. The first exception thrown is rethrown
+// here after all threads have finished.
+template <class First, class Body>
+void parallel_blocks(std::size_t n, int threads, std::size_t block, First first, Body body) {
+    if (threads < 2 || n == 0) {
+        first();
+        if (n > 0) body(std::size_t{0}, n);
+        return;
+    }
+    if (block < 1) block = 1;
+    std::atomic<std::size_t> next{0};
+    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads));
+    auto take = [&](std::size_t k, bool with_first) {
+        try {
+            if (with_first) first();
+            for (;;) {
+                const std::size_t lo = next.fetch_add(block);
+                if (lo >= n) return;
+                body(lo, lo + block < n ? lo + block : n);
+            }
+        } catch (...) {
+            errors[k] = std::current_exception();
+            next = n;  // the others stop after their current block
+        }
+    };
+    std::vector<std::thread> pool;
+    pool.reserve(static_cast<std::size_t>(threads) - 1);
+    try {
+        for (int k = 1; k < threads; ++k) pool.emplace_back(take, static_cast<std::size_t>(k), false);
+    } catch (...) {
+        next = n;
+        for (auto& th : pool) th.join();
+        throw;
+    }
+    take(0, true);
     for (auto& th : pool) th.join();
     for (auto& e : errors)
         if (e) std::rethrow_exception(e);

@@ -45,6 +45,9 @@ public:
     const std::vector<Bridge>& bridges() const { return bridges_; }
     const std::vector<BridgeElement>& elements() const { return elements_; }
     const WetParams& params() const { return params_; }
+    // Bridge elements evaluated per chunk when a Hessian is wanted (2 KB of buffer each; default 16384, enough for
+    // the dry terms to run beside the first chunk on a 1e4-fiber network). Results do not depend on it.
+    void set_chunk(size_t elements) { chunk_ = elements < 1 ? 1 : elements; }
 
 private:
     double eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd);
@@ -62,7 +65,8 @@ private:
     mutable std::vector<int> bridge_slots_; // 256 per bridge: union value index of local (a, b) with row <= col, else -1
     EnergyEval eval_;
     // Per-chunk element results (eval): filled in parallel, summed in element order.
-    static constexpr size_t kChunk = 2048, kParallelMin = 1024;
+    static constexpr size_t kParallelMin = 1024;
+    size_t chunk_ = 16384;  // set_chunk
     std::vector<double> chunk_E_;
     std::vector<Vector16d, Eigen::aligned_allocator<Vector16d>> chunk_g_;
     std::vector<Matrix16d, Eigen::aligned_allocator<Matrix16d>> chunk_H_;

@@ -18,14 +18,18 @@ namespace fibernet {
 // proportional to their size.
 struct ElementIncidence {
     std::vector<int> seg_start, seg, hinge_start, hinge, bridge_start, bridge;
+    const BridgeElement* bridges_of = nullptr;  // the elements the bridge rows were built from (W.elements().data())
 };
 ElementIncidence element_incidence(const WetEnergy& W);
+// Rebuilds only the bridge rows of inc for W: the segment and hinge rows depend only on the model, which every
+// WetEnergy of one relaxation shares (relax_wet rebuilds O(bridges) per round, not O(network)).
+void update_bridge_incidence(const WetEnergy& W, ElementIncidence& inc);
 
 // Flags (one per node) the nodes holding a free coordinate with |g| > threshold.
 std::vector<char> nodes_above(const NetworkEnergy& dry, const Eigen::VectorXd& g, double threshold);
 // Grows the flagged set `hops` times by whole elements of W (a node joins when it shares a segment, hinge or bridge
-// with a node already in).
-void grow_region(const WetEnergy& W, std::vector<char>& in, int hops);
+// with a node already in); inc is W's incidence. Costs the size of the grown set, not of the network.
+void grow_region(const WetEnergy& W, const ElementIncidence& inc, std::vector<char>& in, int hops);
 // The flagged nodes with coordinates split into parts joined by elements (nodes of distinct parts share no element
 // but held ones); each sorted. Fixed nodes never move and join nothing.
 std::vector<std::vector<int>> region_parts(const WetEnergy& W, const ElementIncidence& inc, const std::vector<char>& in);
