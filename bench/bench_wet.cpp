@@ -64,11 +64,14 @@ int main(int argc, char** argv) {
         "\"rounds\": %d, \"local_rounds\": %d, \"local_iterations\": %d, \"E_total\": %.10g, \"E_capillary\": %.10g, \"stable\": %s, \"cycling\": %s, \"cycles_broken\": %d, \"newton_iterations\": %d, \"events\": %d, "
         "\"seconds\": {\"build\": %.3f, \"dry\": %.3f, \"wet_newton\": %.3f, \"wet_local\": %.3f, \"events\": %.3f, \"update\": %.3f, \"gradient\": %.3f, \"local_setup\": %.3f, \"pores\": %.3f, "
         "\"total\": %.3f}, \"newton\": {\"factorizations\": %d, \"assembly\": %.3f, "
+        "\"factorization\": %.3f, \"solve\": %.3f, \"line_search\": %.3f, \"total\": %.3f}, \"newton_local\": {\"assembly\": %.3f, "
         "\"factorization\": %.3f, \"solve\": %.3f, \"line_search\": %.3f, \"total\": %.3f}, \"message\": \"%s\"}\n",
         net.fibers.size(), q, beta, m.num_nodes(), r.initial_bridges.size(), r.active.bridges.size(), r.active.rounds, r.active.local_rounds, r.active.local_iterations, r.wet.energy.total(), r.wet.energy.capillary,
         r.active.stable ? "true" : "false", r.active.cycling ? "true" : "false", r.active.cycles_broken, r.active.solver_iterations,
         r.active.events.total(), t_build, r.seconds_dry, r.seconds_wet_solve, r.active.seconds_local, r.seconds_events, r.active.seconds_update, r.active.seconds_gradient, r.active.seconds_local_setup, r.seconds_pores, total,
         r.active.factorizations, r.active.timings.assembly, r.active.timings.factorization, r.active.timings.solve,
-        r.active.timings.line_search, r.active.timings.total, r.active.message.c_str());
+        r.active.timings.line_search, r.active.timings.total, r.active.timings_local.assembly,
+        r.active.timings_local.factorization, r.active.timings_local.solve, r.active.timings_local.line_search,
+        r.active.timings_local.total, r.active.message.c_str());
     return 0;
 }

@@ -29,4 +29,57 @@ int pattern_slot(const Eigen::SparseMatrix<double>& P, int r, int c) {
     return static_cast<int>(it - in);
 }
 
+void element_slots(const Eigen::SparseMatrix<double>& P, const std::vector<int>& idx, int M, std::vector<int>& out) {
+    const int n = static_cast<int>(P.cols());
+    const size_t ne = idx.size() / M;
+    out.assign(ne * M * M, -1);
+    // The (element, b) pairs of each column, by counting sort.
+    std::vector<int> start(n + 1, 0);
+    for (int c : idx)
+        if (c >= 0) {
+            if (c >= n) throw std::logic_error("hessian pattern lacks an entry");
+            ++start[c + 1];
+        }
+    for (int c = 0; c < n; ++c) start[c + 1] += start[c];
+    std::vector<int> at(start.begin(), start.end() - 1), list(start[n]);
+    for (size_t k = 0; k < idx.size(); ++k)
+        if (idx[k] >= 0) list[at[idx[k]]++] = static_cast<int>(k);
+    // Column by column: each row's slot scattered into pos, read by every element entry of the column.
+    std::vector<int> pos(n, -1);
+    const int* outer = P.outerIndexPtr();
+    const int* inner = P.innerIndexPtr();
+    for (int c = 0; c < n; ++c) {
+        for (int k = outer[c]; k < outer[c + 1]; ++k) pos[inner[k]] = k;
+        for (int j = start[c]; j < start[c + 1]; ++j) {
+            const size_t e = static_cast<size_t>(list[j]) / M;
+            const int b = list[j] % M;
+            for (int a = 0; a < M; ++a) {
+                const int r = idx[e * M + a];
+                if (r < 0 || r > c) continue;
+                if (pos[r] < 0) throw std::logic_error("hessian pattern lacks an entry");
+                out[e * M * M + a * M + b] = pos[r];
+            }
+        }
+        for (int k = outer[c]; k < outer[c + 1]; ++k) pos[inner[k]] = -1;
+    }
+}
+
+std::vector<int> subpattern_slots(const Eigen::SparseMatrix<double>& P, const Eigen::SparseMatrix<double>& S) {
+    const int n = static_cast<int>(P.cols());
+    if (S.cols() != n || S.rows() != P.rows()) throw std::logic_error("hessian pattern lacks an entry");
+    std::vector<int> out;
+    out.reserve(S.nonZeros());
+    std::vector<int> pos(n, -1);
+    const int *po = P.outerIndexPtr(), *pi = P.innerIndexPtr(), *so = S.outerIndexPtr(), *si = S.innerIndexPtr();
+    for (int c = 0; c < n; ++c) {
+        for (int k = po[c]; k < po[c + 1]; ++k) pos[pi[k]] = k;
+        for (int k = so[c]; k < so[c + 1]; ++k) {
+            if (pos[si[k]] < 0) throw std::logic_error("hessian pattern lacks an entry");
+            out.push_back(pos[si[k]]);
+        }
+        for (int k = po[c]; k < po[c + 1]; ++k) pos[pi[k]] = -1;
+    }
+    return out;
+}
+
 }  // namespace fibernet

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -449,6 +448,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             moved_nodes.swap(region);
             ++r.local_rounds;
             r.local_iterations += all.iterations;
+            r.timings_local += all.timings;
             r.seconds_local += now() - t0;
         } else {
             r.last = solver.minimize(W, q);

@@ -40,17 +40,11 @@ const Eigen::SparseMatrix<double>& WetEnergy::hessian_pattern() const {
                 if (r >= 0 && c >= 0 && r <= c) cols[c].push_back(r);
             }
     pattern_ = pattern_from_columns(n, cols);
-    auto slot = [&](int r, int c) { return pattern_slot(pattern_, r, c); };
-    dry_slot_.reserve(P.nonZeros());
-    for (int c = 0; c < n; ++c)
-        for (Eigen::SparseMatrix<double>::InnerIterator it(P, c); it; ++it) dry_slot_.push_back(slot(static_cast<int>(it.row()), c));
-    bridge_slots_.assign(256 * elements_.size(), -1);
+    dry_slot_ = subpattern_slots(pattern_, P);
+    std::vector<int> idx(16 * elements_.size());
     for (size_t k = 0; k < elements_.size(); ++k)
-        for (int a = 0; a < 16; ++a)
-            for (int b = 0; b < 16; ++b) {
-                const int r = local_dof(elements_[k], a), c = local_dof(elements_[k], b);
-                if (r >= 0 && c >= 0 && r <= c) bridge_slots_[256 * k + 16 * a + b] = slot(r, c);
-            }
+        for (int a = 0; a < 16; ++a) idx[16 * k + a] = local_dof(elements_[k], a);
+    element_slots(pattern_, idx, 16, bridge_slots_);
     dry_H_ = P;
     pattern_built_ = true;  // only now: a build that threw is tried again, not half used
     return pattern_;

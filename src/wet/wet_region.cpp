@@ -185,16 +185,9 @@ WetRegion::WetRegion(const WetEnergy& W, RegionState& state, const std::vector<i
     collect(seg_idx_, 4), collect(hinge_idx_, 6), collect(bridge_idx_, 16);
     for (int c = 0; c < n; ++c) cols[c].push_back(c);  // a diagonal entry for every coordinate
     pattern_ = pattern_from_columns(n, cols);
-    auto slots = [&](const std::vector<int>& idx, int M, std::vector<int>& out) {
-        out.assign(idx.size() / M * M * M, -1);
-        for (size_t e = 0; e < idx.size() / M; ++e)
-            for (int a = 0; a < M; ++a)
-                for (int b = 0; b < M; ++b) {
-                    const int r = idx[e * M + a], c = idx[e * M + b];
-                    if (r >= 0 && c >= 0 && r <= c) out[e * M * M + a * M + b] = pattern_slot(pattern_, r, c);
-                }
-    };
-    slots(seg_idx_, 4, seg_slot_), slots(hinge_idx_, 6, hinge_slot_), slots(bridge_idx_, 16, bridge_slot_);
+    element_slots(pattern_, seg_idx_, 4, seg_slot_);
+    element_slots(pattern_, hinge_idx_, 6, hinge_slot_);
+    element_slots(pattern_, bridge_idx_, 16, bridge_slot_);
 }
 
 Eigen::VectorXd WetRegion::restrict(const Eigen::VectorXd& q) const {

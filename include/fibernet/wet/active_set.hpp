@@ -85,6 +85,7 @@ struct ActiveSetResult {
     int local_iterations = 0;      // solver iterations in those rounds, summed over their parts
     double seconds_local = 0;      // solve time in those rounds (part of seconds_solve)
     SolveTimings timings;          // the solver's time split, summed over rounds
+    SolveTimings timings_local;    // ... over the local rounds' pieces only (part of timings)
     bool stable = false;           // the last round, a global one, changed nothing: q is an equilibrium with a consistent set
     bool cycling = false;          // a bridge set repeated after max_freezes cycles were broken
     int cycles_broken = 0;         // cycles broken by freezing the toggling fiber pairs

@@ -1,0 +1,63 @@
+// Sparse Hessian patterns (energy/sparse_pattern.hpp): the pattern from column lists, and element_slots agreeing with
+// pattern_slot entry by entry.
+#include <catch2/catch.hpp>
+
+#include <stdexcept>
+
+#include "fibernet/energy/sparse_pattern.hpp"
+#include "fibernet/util/random.hpp"
+
+using namespace fibernet;
+
+TEST_CASE("sparse pattern: columns sorted and deduplicated; element_slots equals pattern_slot", "[energy][pattern]") {
+    // Random elements of 3 coordinates over 40, with some coordinates absent (-1).
+    const int n = 40, M = 3, ne = 60;
+    Rng rng(5);
+    std::vector<int> idx(M * ne);
+    for (int& v : idx) v = rng.uniform() < 0.15 ? -1 : static_cast<int>(rng.uniform() * n);
+    std::vector<std::vector<int>> cols(n);
+    for (int e = 0; e < ne; ++e)
+        for (int a = 0; a < M; ++a)
+            for (int b = 0; b < M; ++b) {
+                const int r = idx[e * M + a], c = idx[e * M + b];
+                if (r >= 0 && c >= 0 && r <= c) cols[c].push_back(r);
+            }
+    for (int c = 0; c < n; ++c) cols[c].push_back(c);
+    const Eigen::SparseMatrix<double> P = pattern_from_columns(n, cols);
+    for (int c = 0; c < n; ++c)
+        for (int k = P.outerIndexPtr()[c] + 1; k < P.outerIndexPtr()[c + 1]; ++k)
+            CHECK(P.innerIndexPtr()[k - 1] < P.innerIndexPtr()[k]);
+    std::vector<int> slots;
+    element_slots(P, idx, M, slots);
+    REQUIRE(slots.size() == static_cast<size_t>(M * M * ne));
+    int found = 0;
+    for (int e = 0; e < ne; ++e)
+        for (int a = 0; a < M; ++a)
+            for (int b = 0; b < M; ++b) {
+                const int r = idx[e * M + a], c = idx[e * M + b];
+                const int want = (r >= 0 && c >= 0 && r <= c) ? pattern_slot(P, r, c) : -1;
+                CHECK(slots[e * M * M + a * M + b] == want);
+                found += want >= 0;
+            }
+    CHECK(found > ne);
+    // The slots of a contained pattern (the diagonal and the first element's entries), in its value order.
+    std::vector<std::vector<int>> sub(n);
+    for (int c = 0; c < n; ++c) sub[c].push_back(c);
+    for (int a = 0; a < M; ++a)
+        for (int b = 0; b < M; ++b)
+            if (idx[a] >= 0 && idx[b] >= 0 && idx[a] <= idx[b]) sub[idx[b]].push_back(idx[a]);
+    const Eigen::SparseMatrix<double> S = pattern_from_columns(n, sub);
+    const std::vector<int> in = subpattern_slots(P, S);
+    REQUIRE(in.size() == static_cast<size_t>(S.nonZeros()));
+    for (int c = 0, k = 0; c < n; ++c)
+        for (int j = S.outerIndexPtr()[c]; j < S.outerIndexPtr()[c + 1]; ++j, ++k)
+            CHECK(in[k] == pattern_slot(P, S.innerIndexPtr()[j], c));
+    // An entry the pattern lacks is an error, as with pattern_slot.
+    std::vector<int> bad = {0, n - 1};
+    Eigen::SparseMatrix<double> diag(n, n);
+    for (int c = 0; c < n; ++c) diag.insert(c, c) = 0;
+    diag.makeCompressed();
+    CHECK_THROWS_AS(element_slots(diag, bad, 2, slots), std::logic_error);
+    CHECK_THROWS_AS(pattern_slot(diag, 0, n - 1), std::logic_error);
+    CHECK_THROWS_AS(subpattern_slots(diag, P), std::logic_error);
+}
