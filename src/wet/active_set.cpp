@@ -420,7 +420,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             // result: iterations summed, the worst status (a failure, else an iteration limit), the largest max|g|.
             // Usually built for W after the last round, when the region was chosen.
             if (inc.seg_start.empty()) inc = element_incidence(W);
-            else if (inc.bridges_of != W.elements().data()) update_bridge_incidence(W, inc);
+            else if (inc.bridges_of != W.id()) update_bridge_incidence(W, inc);
             RegionState state(W, q);
             const auto parts = region_parts(W, inc, region);
             r.seconds_local_setup += now() - t0;

@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 
 #include "fibernet/energy/sparse_pattern.hpp"
@@ -9,8 +10,12 @@
 
 namespace fibernet {
 
+namespace {
+std::atomic<std::uint64_t> next_id{1};
+}
+
 WetEnergy::WetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, std::vector<Bridge> bridges, WetParams params)
-    : dry_(dry), F_(F), bridges_(std::move(bridges)), params_(std::move(params)) {
+    : dry_(dry), F_(F), bridges_(std::move(bridges)), params_(std::move(params)), id_(next_id++) {
     const Model& m = dry.model();
     elements_.reserve(bridges_.size());
     for (const Bridge& b : bridges_) elements_.push_back(resolve(m, b));

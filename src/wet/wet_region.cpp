@@ -54,7 +54,7 @@ void update_bridge_incidence(const WetEnergy& W, ElementIncidence& inc) {
         k = 8;
         return static_cast<const int*>(W.elements()[e].node);
     }, inc.bridge_start, inc.bridge);
-    inc.bridges_of = W.elements().data();
+    inc.bridges_of = W.id();
 }
 
 std::vector<char> nodes_above(const NetworkEnergy& dry, const Eigen::VectorXd& g, double threshold) {

@@ -49,8 +49,8 @@ void parallel_ranges(std::size_t n, int threads, Body body) {
 
 // Calls first() and then body(lo, hi) on blocks of `block` items covering [0, n) on the calling thread, while
 // threads - 1 more threads take blocks from the start: for a task (first) that runs beside a loop whose items the
-// threads share as they come free. Results go to per-item slots, as above. The first exception thrown is rethrown
-// here after all threads have finished.
+// threads share as they come free. Results go to per-item slots, as above. An exception (that of the lowest-numbered
+// thread if several threw; the calling thread is number 0) is rethrown here after all threads have finished.
 template <class First, class Body>
 void parallel_blocks(std::size_t n, int threads, std::size_t block, First first, Body body) {
     if (threads < 2 || n == 0) {

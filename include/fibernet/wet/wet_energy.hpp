@@ -7,6 +7,7 @@
 // gradient and Hessian (and hence every solve) is bit for bit the dry one.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <cstdint>
 #include <vector>
 
 #include "fibernet/energy/capillary.hpp"
@@ -45,6 +46,9 @@ public:
     const std::vector<Bridge>& bridges() const { return bridges_; }
     const std::vector<BridgeElement>& elements() const { return elements_; }
     const WetParams& params() const { return params_; }
+    // Distinct for every WetEnergy constructed in this process (never 0): tells whether data derived from one energy
+    // (ElementIncidence, wet_region.hpp) belongs to another.
+    std::uint64_t id() const { return id_; }
     // Bridge elements evaluated per chunk when a Hessian is wanted (2 KB of buffer each; default 16384, enough for
     // the dry terms to run beside the first chunk on a 1e4-fiber network). Results do not depend on it.
     void set_chunk(size_t elements) { chunk_ = elements < 1 ? 1 : elements; }
@@ -58,6 +62,7 @@ private:
     std::vector<Bridge> bridges_;
     std::vector<BridgeElement> elements_;
     WetParams params_;
+    std::uint64_t id_;
     // Built on first use (hessian_pattern()); not thread safe (one WetEnergy per solve).
     mutable bool pattern_built_ = false;
     mutable Eigen::SparseMatrix<double> pattern_, dry_H_;

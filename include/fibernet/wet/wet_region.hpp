@@ -7,6 +7,7 @@
 // with its own line search, at the cost of its size (a global line search is set by the network's worst spot).
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <cstdint>
 #include <vector>
 
 #include "fibernet/energy/objective.hpp"
@@ -18,7 +19,7 @@ namespace fibernet {
 // proportional to their size.
 struct ElementIncidence {
     std::vector<int> seg_start, seg, hinge_start, hinge, bridge_start, bridge;
-    const BridgeElement* bridges_of = nullptr;  // the elements the bridge rows were built from (W.elements().data())
+    std::uint64_t bridges_of = 0;  // WetEnergy::id() of the energy the bridge rows were built from
 };
 ElementIncidence element_incidence(const WetEnergy& W);
 // Rebuilds only the bridge rows of inc for W: the segment and hinge rows depend only on the model, which every
