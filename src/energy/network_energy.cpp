@@ -14,9 +14,10 @@ namespace {
 template <int M>
 constexpr int n_upper() { return M * (M + 1) / 2; }
 
-// Slots for an element on nodes[0..K-1] (2K local coordinates).
+// Slots for an element on nodes[0..K-1] (2K local coordinates), packed upper triangle (a <= b) in row order; unlike
+// fibernet::element_slots (sparse_pattern.hpp), which fills full M x M blocks for the wet energies.
 template <int K>
-void element_slots(const int* nodes, const std::vector<int>& dof, const Eigen::SparseMatrix<double>& P, int* out) {
+void packed_slots(const int* nodes, const std::vector<int>& dof, const Eigen::SparseMatrix<double>& P, int* out) {
     for (int a = 0; a < K; ++a)
         for (int b = a + 1; b < K; ++b)
             if (nodes[a] == nodes[b]) throw std::logic_error("an element uses one node twice");
@@ -94,12 +95,12 @@ NetworkEnergy::NetworkEnergy(const Model& model, EnergyParams params) : model_(m
     seg_slots_.resize(n_upper<4>() * model.segments.size());
     for (size_t e = 0; e < model.segments.size(); ++e) {
         const int nodes[2] = {model.segments[e].i, model.segments[e].j};
-        element_slots<2>(nodes, dof_, pattern_, &seg_slots_[n_upper<4>() * e]);
+        packed_slots<2>(nodes, dof_, pattern_, &seg_slots_[n_upper<4>() * e]);
     }
     hinge_slots_.resize(n_upper<6>() * model.hinges.size());
     for (size_t e = 0; e < model.hinges.size(); ++e) {
         const int nodes[3] = {model.hinges[e].i, model.hinges[e].j, model.hinges[e].k};
-        element_slots<3>(nodes, dof_, pattern_, &hinge_slots_[n_upper<6>() * e]);
+        packed_slots<3>(nodes, dof_, pattern_, &hinge_slots_[n_upper<6>() * e]);
     }
 }
 

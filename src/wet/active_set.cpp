@@ -418,9 +418,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         if (local) {
             // Each part of the region on its own (wet_region.hpp): its own line search and convergence. The round's
             // result: iterations summed, the worst status (a failure, else an iteration limit), the largest max|g|.
-            // Usually built for W after the last round, when the region was chosen.
-            if (inc.seg_start.empty()) inc = element_incidence(W);
-            else if (inc.bridges_of != W.id()) update_bridge_incidence(W, inc);
+            incidence_for(W, inc);  // usually already W's: built after the last round, when the region was chosen
             RegionState state(W, q);
             const auto parts = region_parts(W, inc, region);
             r.seconds_local_setup += now() - t0;
@@ -510,8 +508,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
                     for (int node : resolve(dry.model(), b).node)
                         if (node >= 0) hot[node] = 1;
                 }
-                if (inc.seg_start.empty()) inc = element_incidence(Wn);
-                else update_bridge_incidence(Wn, inc);
+                incidence_for(Wn, inc);
                 grow_region(Wn, inc, hot, opt.local_hops);
                 int n_hot = 0;
                 for (int i = 0; i < dry.model().num_nodes(); ++i)

@@ -7,7 +7,6 @@
 
 namespace fibernet {
 
-
 namespace {
 // Counting sort of (node, element) pairs into compressed rows; nodes_of(e, k) returns element e's k nodes (-1: none).
 template <class NodesOf>
@@ -46,6 +45,11 @@ ElementIncidence element_incidence(const WetEnergy& W) {
     }, inc.hinge_start, inc.hinge);
     update_bridge_incidence(W, inc);
     return inc;
+}
+
+void incidence_for(const WetEnergy& W, ElementIncidence& inc) {
+    if (inc.seg_start.empty()) inc = element_incidence(W);
+    else if (inc.bridges_of != W.id()) update_bridge_incidence(W, inc);
 }
 
 void update_bridge_incidence(const WetEnergy& W, ElementIncidence& inc) {

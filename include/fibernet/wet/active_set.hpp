@@ -93,7 +93,7 @@ struct ActiveSetResult {
     FiberPairs frozen;             // ... which
     std::string message;
     double seconds_solve = 0, seconds_events = 0;
-    // Parts of the above: in seconds_local, building the pieces (incidence, parts, tiles, WetRegion); in
+    // Parts of the above: in seconds_local, building the pieces (incidence, parts, WetRegion); in
     // seconds_events, the bridge update with the set's signature, and the next set's energy and whole gradient.
     double seconds_local_setup = 0, seconds_update = 0, seconds_gradient = 0;
 };

@@ -25,6 +25,9 @@ ElementIncidence element_incidence(const WetEnergy& W);
 // Rebuilds only the bridge rows of inc for W: the segment and hinge rows depend only on the model, which every
 // WetEnergy of one relaxation shares (relax_wet rebuilds O(bridges) per round, not O(network)).
 void update_bridge_incidence(const WetEnergy& W, ElementIncidence& inc);
+// Makes inc W's incidence at the least cost: built whole if empty, its bridge rows rebuilt if they are another
+// energy's (same model), else left as it is.
+void incidence_for(const WetEnergy& W, ElementIncidence& inc);
 
 // Flags (one per node) the nodes holding a free coordinate with |g| > threshold.
 std::vector<char> nodes_above(const NetworkEnergy& dry, const Eigen::VectorXd& g, double threshold);
