@@ -2,6 +2,8 @@
 // replaced by max(|D_j|, floor).
 #include <catch2/catch.hpp>
 
+#include <cholmod.h>
+
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <vector>
@@ -124,4 +126,82 @@ TEST_CASE("cholmod_ldl: inertia and descent on a sparse indefinite matrix", "[ch
         CHECK(x.allFinite());
         CHECK(x.dot(b) > 0);
     }
+}
+
+TEST_CASE("cholmod_ldl: the pre-permuted factorization equals CHOLMOD's own bit for bit", "[cholmod_ldl]") {
+    // CholmodLDL hands CHOLMOD S = P A P^T in its natural order instead of A with the order P (which CHOLMOD
+    // transposes twice per factorization). Same order, same S: the same pivots and solves, exactly. Reference: CHOLMOD
+    // on A itself, with its default analysis, and the modified solve written out with its permutation solves.
+    const int m = 12, n = m * m;
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) {
+            const int k = i * m + j;
+            t.emplace_back(k, k, 4.1 + 0.3 * std::sin(1.7 * k) - ((i * 5 + j * 3) % 13 == 0 ? 6.0 : 0.0));
+            if (j + 1 < m) t.emplace_back(k, k + 1, -1 + 0.1 * std::cos(k));
+            if (i + 1 < m) t.emplace_back(k, k + m, -1 + 0.1 * std::sin(2.3 * k));
+            if (i + 2 < m && j + 1 < m) t.emplace_back(k, k + 2 * m + 1, 0.2);  // a longer coupling: more fill
+        }
+    Eigen::SparseMatrix<double> U(n, n);
+    U.setFromTriplets(t.begin(), t.end());
+    U.makeCompressed();
+    Eigen::VectorXd b(n);
+    for (int i = 0; i < n; ++i) b[i] = std::sin(0.61 * i + 0.3);
+    const double shift = 1e-3, floor = 1e-6;
+
+    cholmod_common c;
+    cholmod_start(&c);
+    c.supernodal = CHOLMOD_SIMPLICIAL, c.final_ll = 0, c.print = 0;
+    cholmod_sparse A{};
+    A.nrow = A.ncol = n, A.nzmax = U.nonZeros();
+    A.p = U.outerIndexPtr(), A.i = U.innerIndexPtr(), A.x = U.valuePtr();
+    A.stype = 1, A.itype = CHOLMOD_INT, A.xtype = CHOLMOD_REAL, A.dtype = CHOLMOD_DOUBLE, A.sorted = 1, A.packed = 1;
+    cholmod_factor* L = cholmod_analyze(&A, &c);
+    REQUIRE(L);
+    double beta[2] = {shift, 0};
+    REQUIRE(cholmod_factorize_p(&A, beta, nullptr, 0, L, &c));
+    REQUIRE(L->minor == L->n);
+    bool identity = true;
+    for (int k = 0; k < n; ++k) identity = identity && static_cast<int*>(L->Perm)[k] == k;
+    REQUIRE_FALSE(identity);  // a fill-reducing order: the case the pre-permutation is for
+    Eigen::VectorXd v = b;
+    int negative = 0;
+    auto apply = [&](int sys) {
+        cholmod_dense B{};
+        B.nrow = B.d = B.nzmax = n, B.ncol = 1, B.x = v.data(), B.xtype = CHOLMOD_REAL, B.dtype = CHOLMOD_DOUBLE;
+        cholmod_dense* X = cholmod_solve(sys, L, &B, &c);
+        REQUIRE(X);
+        std::copy(static_cast<double*>(X->x), static_cast<double*>(X->x) + n, v.data());
+        cholmod_free_dense(&X, &c);
+    };
+    apply(CHOLMOD_P), apply(CHOLMOD_L);
+    const double* Lx = static_cast<const double*>(L->x);
+    const int* Lp = static_cast<const int*>(L->p);
+    for (int j = 0; j < n; ++j) {
+        negative += Lx[Lp[j]] < 0;
+        v[j] /= std::max(std::abs(Lx[Lp[j]]), floor);
+    }
+    apply(CHOLMOD_Lt), apply(CHOLMOD_Pt);
+    cholmod_free_factor(&L, &c);
+    cholmod_finish(&c);
+    REQUIRE(negative > 0);
+
+    CholmodLDL ldl;
+    REQUIRE(ldl.factorize(U, shift));
+    CHECK(ldl.negative_pivots() == negative);
+    const Eigen::VectorXd x = ldl.solve_modified(b, floor);
+    int differ = 0;
+    for (int i = 0; i < n; ++i) differ += x[i] != v[i];
+    CHECK(differ == 0);
+    // New values on the analyzed pattern reuse the analysis (1.5 (A + shift I): the same pivots x 1.5); another
+    // pattern of the same size is refused.
+    Eigen::SparseMatrix<double> U2 = U;
+    for (int k = 0; k < U2.nonZeros(); ++k) U2.valuePtr()[k] *= 1.5;
+    REQUIRE(ldl.factorize(U2, 1.5 * shift));
+    CHECK(ldl.negative_pivots() == negative);
+    CHECK((1.5 * ldl.solve_modified(b, 1.5 * floor) - x).norm() < 1e-12 * x.norm());
+    Eigen::SparseMatrix<double> D(n, n);
+    D.setIdentity();
+    D.makeCompressed();
+    CHECK_THROWS_AS(ldl.factorize(D, 0.0), std::logic_error);
 }
