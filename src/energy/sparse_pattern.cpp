@@ -21,6 +21,51 @@ Eigen::SparseMatrix<double> pattern_from_columns(int n, std::vector<std::vector<
     return P;
 }
 
+Eigen::SparseMatrix<double> PatternBuilder::build() const {
+    // visit(r, c) for every entry of every source (r <= c).
+    auto each = [&](auto visit) {
+        for (const auto* P : patterns_)
+            for (int c = 0; c < P->outerSize(); ++c)
+                for (int k = P->outerIndexPtr()[c]; k < P->outerIndexPtr()[c + 1]; ++k) visit(P->innerIndexPtr()[k], c);
+        for (const Elements& el : elements_) {
+            const std::vector<int>& idx = *el.idx;
+            const int M = el.M;
+            for (size_t e = 0; e < idx.size(); e += M)
+                for (int b = 0; b < M; ++b) {
+                    const int c = idx[e + b];
+                    if (c < 0) continue;
+                    for (int a = 0; a < M; ++a) {
+                        const int r = idx[e + a];
+                        if (r >= 0 && r <= c) visit(r, c);
+                    }
+                }
+        }
+        if (diagonal_)
+            for (int c = 0; c < n_; ++c) visit(c, c);
+    };
+    std::vector<long> start(static_cast<size_t>(n_) + 1, 0);
+    each([&](int, int c) { ++start[c + 1]; });
+    for (int c = 0; c < n_; ++c) start[c + 1] += start[c];
+    std::vector<int> rows(static_cast<size_t>(start[n_]));
+    {
+        std::vector<long> next(start.begin(), start.end() - 1);
+        each([&](int r, int c) { rows[next[c]++] = r; });
+    }
+    std::vector<int> outer(static_cast<size_t>(n_) + 1, 0), inner;
+    inner.reserve(rows.size() / 2);
+    for (int c = 0; c < n_; ++c) {
+        auto b = rows.begin() + start[c], e = rows.begin() + start[c + 1];
+        std::sort(b, e);
+        inner.insert(inner.end(), b, std::unique(b, e));
+        outer[c + 1] = static_cast<int>(inner.size());
+    }
+    std::vector<double> zeros(inner.size(), 0.0);
+    Eigen::SparseMatrix<double> P = Eigen::Map<const Eigen::SparseMatrix<double>>(
+        n_, n_, static_cast<Eigen::Index>(inner.size()), outer.data(), inner.data(), zeros.data());
+    P.makeCompressed();
+    return P;
+}
+
 int pattern_slot(const Eigen::SparseMatrix<double>& P, int r, int c) {
     const int* in = P.innerIndexPtr();
     const int b = P.outerIndexPtr()[c], e = P.outerIndexPtr()[c + 1];

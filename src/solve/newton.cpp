@@ -129,11 +129,10 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         // Round-off floor: coordinates are stored to ulp(q_j), so the gradient of the best representable state is
         // uncertain by about (|H| ulp(q))_i. With segments of 1e-4 in a box of side 100 this is ~1e-8, above the
         // default tol 1e-10 (docs/moduli.md, "Round-off floor"). The bound below is pessimistic (~10x).
-        const double floor = roundoff_floor(H, q);
-        r.grad_floor = floor;
         // Stop there only when progress has stopped too (max|g| not halved and the energy flat to 1e-11 over the
         // last 3 iterations), so this pessimistic bound (10-100x on Mikado networks) never cuts a converging or
-        // still-descending Newton short.
+        // still-descending Newton short. The bound costs a pass over H: computed only then (and for the verbose
+        // line, and once for the returned state).
         const int h = static_cast<int>(history_.size());
         energies.push_back(fq);
         bool stalled = h >= 4 && gmax > 0.5 * std::min({history_[h - 2], history_[h - 3], history_[h - 4]});
@@ -141,6 +140,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
             const auto [lo, hi] = std::minmax_element(energies.end() - 4, energies.end());
             stalled = *hi - *lo <= 1e-11 * (1 + std::abs(fq));
         }
+        const double floor = stalled || opt_.verbose ? roundoff_floor(H, q) : 0.0;
         if (gmax <= floor && stalled) {
             r.status = SolveStatus::Converged;
             char buf[160];
@@ -308,6 +308,9 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         q = qt;
         start_rung = std::max(0, std::min(rung, 2) - 1);
     }
+    // The floor at the returned state: H was assembled there (every exit follows an assembly at q; a failed line
+    // search leaves q where H was assembled).
+    if (n > 0 && r.evaluations > 0 && r.status != SolveStatus::NonFinite) r.grad_floor = roundoff_floor(H, q);
     r.timings.total = since(t_start);
     if (mu_lm > 0 && dm_last > 0) shift_rel_ = mu_lm / dm_last;
     if (opt_.verbose)

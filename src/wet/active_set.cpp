@@ -95,11 +95,19 @@ void near_pairs(const Model& m, const SegGeom& g, const Eigen::Matrix2d& B, doub
     for (int c = 0; c < 2; ++c)
         nc[c] = std::max(1, std::min(4096, static_cast<int>(std::floor(span[c] / std::max(reach, 1e-300)))));
     if (m.box.periodic && (nc[0] < 3 || nc[1] < 3)) nc[0] = nc[1] = 1;  // small box: all pairs
-    std::vector<std::vector<int>> cell(static_cast<size_t>(nc[0]) * nc[1]);
     auto cell_of = [&](const Eigen::Vector2d& u, int c) {
         return std::min(nc[c] - 1, std::max(0, static_cast<int>((u[c] - lo[c]) / span[c] * nc[c])));
     };
-    for (int e = 0; e < ns; ++e) cell[cell_of(U[e], 0) + nc[0] * cell_of(U[e], 1)].push_back(e);
+    // Cells as one bucketed array (segments in increasing order within a cell): up to ~1e5 cells at 1e4 fibers, which
+    // as separate vectors cost an allocation each on every search.
+    const size_t ncell = static_cast<size_t>(nc[0]) * nc[1];
+    std::vector<int> cell_start(ncell + 1, 0), cell_items(ns), home(ns);
+    for (int e = 0; e < ns; ++e) ++cell_start[(home[e] = cell_of(U[e], 0) + nc[0] * cell_of(U[e], 1)) + 1];
+    for (size_t c = 0; c < ncell; ++c) cell_start[c + 1] += cell_start[c];
+    {
+        std::vector<int> next(cell_start.begin(), cell_start.end() - 1);
+        for (int e = 0; e < ns; ++e) cell_items[next[home[e]]++] = e;
+    }
     auto test = [&](int a, int b) {
         if (g.fiber[a] == g.fiber[b]) return;
         const Segment &sa = m.segments[a], &sb = m.segments[b];
@@ -120,7 +128,8 @@ void near_pairs(const Model& m, const SegGeom& g, const Eigen::Matrix2d& B, doub
                 int X = cx + dx, Y = cy + dy;
                 if (m.box.periodic) X = (X + nc[0]) % nc[0], Y = (Y + nc[1]) % nc[1];
                 else if (X < 0 || Y < 0 || X >= nc[0] || Y >= nc[1]) continue;
-                for (int b : cell[X + nc[0] * Y]) f(b);
+                const int c = X + nc[0] * Y;
+                for (int k = cell_start[c]; k < cell_start[c + 1]; ++k) f(cell_items[k]);
             }
     };
     if (only) {  // from the flagged segments alone, each pair once (a flagged pair from its lower index)
@@ -133,10 +142,12 @@ void near_pairs(const Model& m, const SegGeom& g, const Eigen::Matrix2d& B, doub
     }
     for (int cy = 0; cy < nc[1]; ++cy)
         for (int cx = 0; cx < nc[0]; ++cx)
-            for (int a : cell[cx + nc[0] * cy])
+            for (int k = cell_start[cx + nc[0] * cy]; k < cell_start[cx + nc[0] * cy + 1]; ++k) {
+                const int a = cell_items[k];
                 around(cx, cy, [&](int b) {
                     if (b > a) test(a, b);
                 });
+            }
 }
 
 bool intersects(const Eigen::Vector2d& Pa, const Eigen::Vector2d& Da, const Eigen::Vector2d& Pb, const Eigen::Vector2d& Db) {
@@ -168,9 +179,10 @@ Contact contact(const Eigen::Vector2d& Pa, const Eigen::Vector2d& Da, const Eige
 }
 }  // namespace
 
-std::vector<Bridge> segment_crossings(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
-                                      const std::vector<char>* only) {
-    const SegGeom g = seg_geom(m, x, B);
+namespace {
+// The searches below on a segment geometry computed once (update_bridges runs both at the same state).
+std::vector<Bridge> crossings_of(const Model& m, const SegGeom& g, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+                                 const std::vector<char>* only) {
     std::vector<Bridge> out;
     near_pairs(m, g, B, 0.0, only, [&](int a, int b, const Eigen::Vector2d& Pb) {
         if (intersects(g.P[a], g.D[a], Pb, g.D[b]))
@@ -179,9 +191,8 @@ std::vector<Bridge> segment_crossings(const Model& m, const Eigen::VectorXd& x, 
     return out;
 }
 
-std::vector<Bridge> segment_contacts(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double distance,
-                                     double angle_deg, const std::vector<char>* only) {
-    const SegGeom g = seg_geom(m, x, B);
+std::vector<Bridge> contacts_of(const Model& m, const SegGeom& g, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+                                double distance, double angle_deg, const std::vector<char>* only) {
     const double smax = std::sin(angle_deg * M_PI / 180);
     std::vector<Bridge> out;
     near_pairs(m, g, B, distance, only, [&](int a, int b, const Eigen::Vector2d& Pb) {
@@ -196,6 +207,17 @@ std::vector<Bridge> segment_contacts(const Model& m, const Eigen::VectorXd& x, c
         }
     });
     return out;
+}
+}  // namespace
+
+std::vector<Bridge> segment_crossings(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+                                      const std::vector<char>* only) {
+    return crossings_of(m, seg_geom(m, x, B), x, B, only);
+}
+
+std::vector<Bridge> segment_contacts(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double distance,
+                                     double angle_deg, const std::vector<char>* only) {
+    return contacts_of(m, seg_geom(m, x, B), x, B, distance, angle_deg, only);
 }
 
 WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
@@ -281,11 +303,17 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
         }
         kept.push_back(b);
     }
-    // Two bridges on one pair: keep the first.
-    std::set<Key> seen;
+    // Two bridges on one pair: keep the first. Found by sorting (key, position) pairs: a set of 4e4 keys (1e4 fibers)
+    // cost more in allocations every round.
+    std::vector<std::pair<Key, int>> order(kept.size());
+    for (size_t k = 0; k < kept.size(); ++k) order[k] = {key(kept[k]), static_cast<int>(k)};
+    std::sort(order.begin(), order.end());
+    std::vector<char> duplicate(kept.size(), 0);
+    for (size_t k = 1; k < order.size(); ++k)
+        if (order[k].first == order[k - 1].first) duplicate[order[k].second] = 1;  // a later one of equal keys
     bridges.clear();
-    for (const Bridge& b : kept) {
-        if (seen.insert(key(b)).second) bridges.push_back(b);
+    for (size_t k = 0; k < kept.size(); ++k) {
+        if (!duplicate[k]) bridges.push_back(kept[k]);
         else ++ev.merged;
     }
     if (!opt.form_new) return ev;
@@ -299,8 +327,9 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
         }
     }
     const std::vector<char>* only = moved ? &seg_moved : nullptr;
-    const std::vector<Bridge> crossings = segment_crossings(m, x, B, only);
-    const std::vector<Bridge> contacts = segment_contacts(m, x, B, rc, opt.contact_angle_deg, only);
+    const SegGeom geom = seg_geom(m, x, B);
+    const std::vector<Bridge> crossings = crossings_of(m, geom, x, B, only);
+    const std::vector<Bridge> contacts = contacts_of(m, geom, x, B, rc, opt.contact_angle_deg, only);
     // Existing bridges by fiber pair and image: a crossing on or next to a bridged pair is that bridge's (a crossing
     // at a node is found on either side of it); a contact needs both its segments free towards the other fiber. Only
     // the fiber pairs of the candidates are looked up, so only their bridges are indexed (a local round's candidates

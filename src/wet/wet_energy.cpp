@@ -31,24 +31,18 @@ const Eigen::SparseMatrix<double>& WetEnergy::hessian_pattern() const {
         pattern_built_ = true;
         return pattern_;
     }
-    // Union pattern, column by column.
+    // Union pattern of the dry one and the bridge elements.
     const Eigen::SparseMatrix<double>& P = dry.hessian_pattern();
     const int n = dry.num_dofs();
-    std::vector<std::vector<int>> cols(n);
-    for (int c = 0; c < n; ++c)
-        for (Eigen::SparseMatrix<double>::InnerIterator it(P, c); it; ++it) cols[c].push_back(static_cast<int>(it.row()));
     auto local_dof = [&](const BridgeElement& e, int a) { return e.node[a / 2] < 0 ? -1 : dry.dof(e.node[a / 2], a % 2); };
-    for (const BridgeElement& e : elements_)
-        for (int a = 0; a < 16; ++a)
-            for (int b = 0; b < 16; ++b) {
-                const int r = local_dof(e, a), c = local_dof(e, b);
-                if (r >= 0 && c >= 0 && r <= c) cols[c].push_back(r);
-            }
-    pattern_ = pattern_from_columns(n, cols);
-    dry_slot_ = subpattern_slots(pattern_, P);
     std::vector<int> idx(16 * elements_.size());
     for (size_t k = 0; k < elements_.size(); ++k)
         for (int a = 0; a < 16; ++a) idx[16 * k + a] = local_dof(elements_[k], a);
+    PatternBuilder union_pattern(n);
+    union_pattern.add_pattern(P);
+    union_pattern.add_elements(idx, 16);
+    pattern_ = union_pattern.build();
+    dry_slot_ = subpattern_slots(pattern_, P);
     element_slots(pattern_, idx, 16, bridge_slots_);
     dry_H_ = P;
     pattern_built_ = true;  // only now: a build that threw is tried again, not half used

@@ -176,19 +176,10 @@ WetRegion::WetRegion(const WetEnergy& W, RegionState& state, const std::vector<i
     for (int e : bridges_) index(W.elements()[e].node, 8, bridge_idx_);
 
     // Upper-triangular pattern over the region's coordinates, then each element's value slots.
-    const int n = size();
-    std::vector<std::vector<int>> cols(n);
-    auto collect = [&](const std::vector<int>& idx, int M) {
-        for (size_t e = 0; e < idx.size(); e += M)
-            for (int a = 0; a < M; ++a)
-                for (int b = 0; b < M; ++b) {
-                    const int r = idx[e + a], c = idx[e + b];
-                    if (r >= 0 && c >= 0 && r <= c) cols[c].push_back(r);
-                }
-    };
-    collect(seg_idx_, 4), collect(hinge_idx_, 6), collect(bridge_idx_, 16);
-    for (int c = 0; c < n; ++c) cols[c].push_back(c);  // a diagonal entry for every coordinate
-    pattern_ = pattern_from_columns(n, cols);
+    PatternBuilder builder(size());
+    builder.add_elements(seg_idx_, 4), builder.add_elements(hinge_idx_, 6), builder.add_elements(bridge_idx_, 16);
+    builder.add_diagonal();  // a diagonal entry for every coordinate
+    pattern_ = builder.build();
     element_slots(pattern_, seg_idx_, 4, seg_slot_);
     element_slots(pattern_, hinge_idx_, 6, hinge_slot_);
     element_slots(pattern_, bridge_idx_, 16, bridge_slot_);

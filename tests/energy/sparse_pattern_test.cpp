@@ -2,6 +2,7 @@
 // pattern_slot entry by entry.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "fibernet/energy/sparse_pattern.hpp"
@@ -60,4 +61,49 @@ TEST_CASE("sparse pattern: columns sorted and deduplicated; element_slots equals
     CHECK_THROWS_AS(element_slots(diag, bad, 2, slots), std::logic_error);
     CHECK_THROWS_AS(pattern_slot(diag, 0, n - 1), std::logic_error);
     CHECK_THROWS_AS(subpattern_slots(diag, P), std::logic_error);
+}
+
+TEST_CASE("sparse pattern: PatternBuilder equals pattern_from_columns", "[energy][pattern]") {
+    // A base pattern, two element lists of different sizes with absent coordinates, and the diagonal.
+    const int n = 50;
+    Rng rng(11);
+    auto elements = [&](int M, int ne) {
+        std::vector<int> idx(M * ne);
+        for (int& v : idx) v = rng.uniform() < 0.2 ? -1 : static_cast<int>(rng.uniform() * n);
+        return idx;
+    };
+    const std::vector<int> e3 = elements(3, 40), e5 = elements(5, 25), base_idx = elements(2, 30);
+    std::vector<std::vector<int>> base_cols(n), cols(n);
+    auto collect = [](std::vector<std::vector<int>>& into, const std::vector<int>& idx, int M) {
+        for (size_t e = 0; e < idx.size(); e += M)
+            for (int a = 0; a < M; ++a)
+                for (int b = 0; b < M; ++b) {
+                    const int r = idx[e + a], c = idx[e + b];
+                    if (r >= 0 && c >= 0 && r <= c) into[c].push_back(r);
+                }
+    };
+    collect(base_cols, base_idx, 2);
+    const Eigen::SparseMatrix<double> base = pattern_from_columns(n, base_cols);
+    collect(cols, base_idx, 2), collect(cols, e3, 3), collect(cols, e5, 5);
+    for (int c = 0; c < n; ++c) cols[c].push_back(c);
+    const Eigen::SparseMatrix<double> want = pattern_from_columns(n, cols);
+
+    PatternBuilder builder(n);
+    builder.add_pattern(base);
+    builder.add_elements(e3, 3);
+    builder.add_elements(e5, 5);
+    builder.add_diagonal();
+    const Eigen::SparseMatrix<double> got = builder.build();
+    REQUIRE(got.nonZeros() == want.nonZeros());
+    CHECK(std::equal(got.outerIndexPtr(), got.outerIndexPtr() + n + 1, want.outerIndexPtr()));
+    CHECK(std::equal(got.innerIndexPtr(), got.innerIndexPtr() + got.nonZeros(), want.innerIndexPtr()));
+    // Without the diagonal, columns with no entry stay empty.
+    PatternBuilder sparse(n);
+    sparse.add_elements(e3, 3);
+    const Eigen::SparseMatrix<double> s3 = sparse.build();
+    std::vector<std::vector<int>> c3(n);
+    collect(c3, e3, 3);
+    const Eigen::SparseMatrix<double> w3 = pattern_from_columns(n, c3);
+    REQUIRE(s3.nonZeros() == w3.nonZeros());
+    CHECK(std::equal(s3.innerIndexPtr(), s3.innerIndexPtr() + s3.nonZeros(), w3.innerIndexPtr()));
 }
