@@ -28,31 +28,30 @@ inline cholmod_sparse cholmod_upper_view(const Eigen::SparseMatrix<double>& A, c
     return s;
 }
 
-// One triangle of S = P A P^T for the upper triangle of a symmetric A and a fill-reducing order perm (perm[k]: the row
-// of A eliminated k-th), with rows sorted in each column. CHOLMOD factors a matrix analyzed in its natural order as
-// given, where with an order of its own it first permutes and transposes the input on every factorization
-// (cholmod_factorize.c: twice for a simplicial LDL^T of an upper triangle, 15 % of its time on wet Hessians; once
-// for a supernodal LL^T, about 5 % there, not worth the second analysis: CholmodLLT does not use this). Built once
-// per pattern; gather() then moves new values of A into place.
+// The upper triangle of S = P A P^T for the upper triangle of a symmetric A (entries r <= c only) and a
+// fill-reducing order perm (perm[k]: the row of A eliminated k-th), with rows sorted in each column. CHOLMOD factors a
+// matrix analyzed in its natural order as given, where with an order of its own it first permutes and transposes the
+// input on every factorization (cholmod_factorize.c: twice for a simplicial LDL^T of an upper triangle, 13 % of a
+// factorization of a 1e4-fiber wet Hessian in its first round; once for a supernodal LL^T, about 5 % there and not
+// worth the second analysis: CholmodLLT does not use this). Built once per pattern; gather() then moves new values
+// of A into place.
 struct PermutedTriangle {
-    std::vector<int> p, i, from;  // CSC pattern of S's triangle; from[k]: the entry of A that S's entry k is
+    std::vector<int> p, i, from;  // CSC pattern of S's upper triangle; from[k]: the entry of A that S's entry k is
     std::vector<double> x;
-    int stype = 1;                // 1: upper triangle, -1: lower (CHOLMOD's convention)
 
     PermutedTriangle() = default;
-    PermutedTriangle(const Eigen::SparseMatrix<double>& upper, const std::vector<int>& perm, bool lower) {
+    PermutedTriangle(const Eigen::SparseMatrix<double>& upper, const std::vector<int>& perm) {
         const int n = static_cast<int>(upper.rows());
-        stype = lower ? -1 : 1;
         std::vector<int> pinv(n);
         for (int k = 0; k < n; ++k) pinv[perm[k]] = k;
         const long nz = upper.nonZeros();
-        // Bucketed by row and then, stably, by column: each column's rows come out sorted.
+        // Bucketed by row and then, stably, by column: each column's rows come out sorted, as CHOLMOD's transposes
+        // leave them.
         std::vector<int> row(nz), col(nz), by_row(nz), count(n + 1, 0);
         for (int j = 0; j < n; ++j)
             for (int k = upper.outerIndexPtr()[j]; k < upper.outerIndexPtr()[j + 1]; ++k) {
                 const int a = pinv[upper.innerIndexPtr()[k]], b = pinv[j];
-                row[k] = lower ? std::max(a, b) : std::min(a, b);
-                col[k] = lower ? std::min(a, b) : std::max(a, b);
+                row[k] = std::min(a, b), col[k] = std::max(a, b);
                 ++count[row[k] + 1];
             }
         for (int r = 0; r < n; ++r) count[r + 1] += count[r];
@@ -77,7 +76,7 @@ struct PermutedTriangle {
         S.nrow = S.ncol = p.empty() ? 0 : p.size() - 1;
         S.nzmax = i.size();
         S.p = p.data(), S.i = i.data(), S.x = x.data();
-        S.stype = stype, S.itype = CHOLMOD_INT, S.xtype = CHOLMOD_REAL, S.dtype = CHOLMOD_DOUBLE;
+        S.stype = 1, S.itype = CHOLMOD_INT, S.xtype = CHOLMOD_REAL, S.dtype = CHOLMOD_DOUBLE;
         S.sorted = 1, S.packed = 1;
         return S;
     }

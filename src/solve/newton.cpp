@@ -309,8 +309,8 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         start_rung = std::max(0, std::min(rung, 2) - 1);
     }
     // The floor at the returned state: H was assembled there (every exit follows an assembly at q; a failed line
-    // search leaves q where H was assembled).
-    if (n > 0 && r.evaluations > 0 && r.status != SolveStatus::NonFinite) r.grad_floor = roundoff_floor(H, q);
+    // search leaves q where H was assembled, possibly as the projected Hessian of the ladder's lower rungs).
+    if (n > 0 && r.status != SolveStatus::NonFinite) r.grad_floor = roundoff_floor(H, q);
     r.timings.total = since(t_start);
     if (mu_lm > 0 && dm_last > 0) shift_rel_ = mu_lm / dm_last;
     if (opt_.verbose)

@@ -105,5 +105,6 @@ TEST_CASE("sparse pattern: PatternBuilder equals pattern_from_columns", "[energy
     collect(c3, e3, 3);
     const Eigen::SparseMatrix<double> w3 = pattern_from_columns(n, c3);
     REQUIRE(s3.nonZeros() == w3.nonZeros());
+    CHECK(std::equal(s3.outerIndexPtr(), s3.outerIndexPtr() + n + 1, w3.outerIndexPtr()));
     CHECK(std::equal(s3.innerIndexPtr(), s3.innerIndexPtr() + s3.nonZeros(), w3.innerIndexPtr()));
 }

@@ -193,8 +193,8 @@ TEST_CASE("cholmod_ldl: the pre-permuted factorization equals CHOLMOD's own bit 
     int differ = 0;
     for (int i = 0; i < n; ++i) differ += x[i] != v[i];
     CHECK(differ == 0);
-    // New values on the analyzed pattern reuse the analysis (1.5 (A + shift I): the same pivots x 1.5); another
-    // pattern of the same size is refused.
+    // New values on the analyzed pattern reuse the analysis (1.5 (A + shift I): the same pivots x 1.5); a matrix of the
+    // same size with another number of entries is refused, as is a right-hand side of another size.
     Eigen::SparseMatrix<double> U2 = U;
     for (int k = 0; k < U2.nonZeros(); ++k) U2.valuePtr()[k] *= 1.5;
     REQUIRE(ldl.factorize(U2, 1.5 * shift));
@@ -204,4 +204,5 @@ TEST_CASE("cholmod_ldl: the pre-permuted factorization equals CHOLMOD's own bit 
     D.setIdentity();
     D.makeCompressed();
     CHECK_THROWS_AS(ldl.factorize(D, 0.0), std::logic_error);
+    CHECK_THROWS_AS(ldl.solve_modified(Eigen::VectorXd::Ones(n + 1), floor), std::logic_error);
 }

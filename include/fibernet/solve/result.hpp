@@ -34,7 +34,7 @@ struct SolveResult {
     int evaluations = 0;                // energy/gradient evaluations
     double energy = 0;
     double grad_max = 0;                // max |g| at the returned state
-    double grad_floor = 0;              // round-off floor of max |g| at the returned state (0: not estimated)
+    double grad_floor = 0;              // round-off floor of max |g| at the returned state (Newton; 0: not estimated)
     SolveTimings timings;
 
     bool converged() const { return status == SolveStatus::Converged; }
