@@ -5,22 +5,6 @@
 
 namespace fibernet {
 
-Eigen::SparseMatrix<double> pattern_from_columns(int n, std::vector<std::vector<int>>& cols) {
-    std::vector<int> outer(n + 1, 0), inner;
-    for (int c = 0; c < n; ++c) {
-        auto& v = cols[c];
-        std::sort(v.begin(), v.end());
-        v.erase(std::unique(v.begin(), v.end()), v.end());
-        inner.insert(inner.end(), v.begin(), v.end());
-        outer[c + 1] = static_cast<int>(inner.size());
-    }
-    std::vector<double> zeros(inner.size(), 0.0);
-    Eigen::SparseMatrix<double> P = Eigen::Map<const Eigen::SparseMatrix<double>>(
-        n, n, static_cast<Eigen::Index>(inner.size()), outer.data(), inner.data(), zeros.data());
-    P.makeCompressed();
-    return P;
-}
-
 Eigen::SparseMatrix<double> PatternBuilder::build() const {
     // visit(r, c) for every entry of every source (r <= c).
     auto each = [&](auto visit) {

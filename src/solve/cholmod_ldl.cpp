@@ -19,8 +19,7 @@ struct CholmodLDL::Impl {
     // The fill-reducing P (perm[k]: the row of A eliminated k-th) and the upper triangle of S, which
     // cholmod_factorize_p takes as is (cholmod_view.hpp), without transposing it twice per call.
     std::vector<int> perm;
-    detail::PermutedTriangle S;
-    long nnz = 0;  // of the analyzed A
+    detail::PermutedTriangle S;  // as many entries as the analyzed A
     bool ok = false;
     int negative = 0;
     double min_pivot = 0;
@@ -69,7 +68,6 @@ void CholmodLDL::analyze(const Eigen::SparseMatrix<double>& upper) {
     m.perm.assign(static_cast<const int*>(L0->Perm), static_cast<const int*>(L0->Perm) + n);
     cholmod_free_factor(&L0, &m.c);
     m.S = detail::PermutedTriangle(upper, m.perm);
-    m.nnz = upper.nonZeros();
     cholmod_sparse S = m.S.view();
     m.L = detail::analyze_natural(S, m.c);
     if (!m.L) throw std::runtime_error("CHOLMOD symbolic analysis failed (status " + std::to_string(m.c.status) + ")");
@@ -79,7 +77,7 @@ bool CholmodLDL::factorize(const Eigen::SparseMatrix<double>& upper, double shif
     // A matrix of another size is analyzed first; one of the same size is taken to have the analyzed pattern.
     if (!impl_->L || impl_->L->n != static_cast<size_t>(upper.rows())) analyze(upper);
     Impl& m = *impl_;
-    if (!upper.isCompressed() || upper.nonZeros() != m.nnz)
+    if (!upper.isCompressed() || upper.nonZeros() != m.S.nonzeros())
         throw std::logic_error("CholmodLDL::factorize: the matrix is not compressed or not of the analyzed pattern");
     m.S.gather(upper);
     cholmod_sparse S = m.S.view();

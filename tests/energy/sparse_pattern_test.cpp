@@ -1,5 +1,5 @@
-// Sparse Hessian patterns (energy/sparse_pattern.hpp): the pattern from column lists, and element_slots agreeing with
-// pattern_slot entry by entry.
+// Sparse Hessian patterns (energy/sparse_pattern.hpp): PatternBuilder against a pattern built from column lists here,
+// and element_slots and subpattern_slots agreeing with pattern_slot entry by entry.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -9,6 +9,19 @@
 #include "fibernet/util/random.hpp"
 
 using namespace fibernet;
+
+namespace {
+// The reference: the pattern whose column c holds the rows cols[c] (any order, repeats allowed), by Eigen's triplets.
+Eigen::SparseMatrix<double> pattern_from_columns(int n, const std::vector<std::vector<int>>& cols) {
+    std::vector<Eigen::Triplet<double>> t;
+    for (int c = 0; c < n; ++c)
+        for (int r : cols[c]) t.emplace_back(r, c, 0.0);
+    Eigen::SparseMatrix<double> P(n, n);
+    P.setFromTriplets(t.begin(), t.end());
+    P.makeCompressed();
+    return P;
+}
+}  // namespace
 
 TEST_CASE("sparse pattern: columns sorted and deduplicated; element_slots equals pattern_slot", "[energy][pattern]") {
     // Random elements of 3 coordinates over 40, with some coordinates absent (-1).
@@ -24,7 +37,13 @@ TEST_CASE("sparse pattern: columns sorted and deduplicated; element_slots equals
                 if (r >= 0 && c >= 0 && r <= c) cols[c].push_back(r);
             }
     for (int c = 0; c < n; ++c) cols[c].push_back(c);
-    const Eigen::SparseMatrix<double> P = pattern_from_columns(n, cols);
+    PatternBuilder builder(n);
+    builder.add_elements(idx, M);
+    builder.add_diagonal();
+    const Eigen::SparseMatrix<double> P = builder.build();
+    const Eigen::SparseMatrix<double> want = pattern_from_columns(n, cols);
+    REQUIRE(P.nonZeros() == want.nonZeros());
+    CHECK(std::equal(P.innerIndexPtr(), P.innerIndexPtr() + P.nonZeros(), want.innerIndexPtr()));
     for (int c = 0; c < n; ++c)
         for (int k = P.outerIndexPtr()[c] + 1; k < P.outerIndexPtr()[c + 1]; ++k)
             CHECK(P.innerIndexPtr()[k - 1] < P.innerIndexPtr()[k]);
@@ -63,7 +82,7 @@ TEST_CASE("sparse pattern: columns sorted and deduplicated; element_slots equals
     CHECK_THROWS_AS(subpattern_slots(diag, P), std::logic_error);
 }
 
-TEST_CASE("sparse pattern: PatternBuilder equals pattern_from_columns", "[energy][pattern]") {
+TEST_CASE("sparse pattern: PatternBuilder from patterns, elements of several sizes and the diagonal", "[energy][pattern]") {
     // A base pattern, two element lists of different sizes with absent coordinates, and the diagonal.
     const int n = 50;
     Rng rng(11);

@@ -1,17 +1,15 @@
 #pragma once
-// Upper-triangular CSC Hessian patterns built from per-column row lists, and the value slot of an entry: shared by
-// the energies that assemble into a fixed pattern (wet_energy.hpp, wet_region.hpp, network_energy.hpp).
+// Upper-triangular CSC Hessian patterns built from elements and other patterns, and the value slots of entries: shared
+// by the energies that assemble into a fixed pattern (wet_energy.hpp, wet_region.hpp, network_energy.hpp).
 #include <Eigen/SparseCore>
 #include <vector>
 
 namespace fibernet {
 
-// The pattern of an n x n matrix whose column c holds rows cols[c] (any order, repeats allowed; sorted in place).
-Eigen::SparseMatrix<double> pattern_from_columns(int n, std::vector<std::vector<int>>& cols);
-
-// The same pattern built by counting (two passes over the entries, no list per column), from any mix of: every entry
-// of given patterns, the upper M x M entries of elements (idx as in element_slots below), the diagonal. For the wet
-// Hessian's union pattern, built once per bridge set: ~1e7 entries at 1e4 fibers.
+// An upper-triangular pattern (rows sorted and unique in each column, values zero) built by counting (two passes over
+// the entries, no list per column) from any mix of: every entry of given patterns, the upper M x M entries of
+// elements (idx as in element_slots below), the diagonal. For the wet Hessian's union pattern, built once per bridge
+// set: ~1e7 entries at 1e4 fibers.
 class PatternBuilder {
 public:
     explicit PatternBuilder(int n) : n_(n) {}
