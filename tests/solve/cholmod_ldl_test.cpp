@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fibernet/solve/cholmod_ldl.hpp"
+#include "fibernet/util/parallel.hpp"
 
 using namespace fibernet;
 
@@ -205,4 +206,120 @@ TEST_CASE("cholmod_ldl: the pre-permuted factorization equals CHOLMOD's own bit 
     D.makeCompressed();
     CHECK_THROWS_AS(ldl.factorize(D, 0.0), std::logic_error);
     CHECK_THROWS_AS(ldl.solve_modified(Eigen::VectorXd::Ones(n + 1), floor), std::logic_error);
+}
+
+TEST_CASE("cholmod_ldl: the two-thread order factors as CHOLMOD would in that order, on any thread count",
+          "[cholmod_ldl]") {
+    // A grid with indefinite spots and longer couplings, large enough for a separator; split_min 100 forces the
+    // two-thread order (bisection, CAMD within [A][B][S]) that large Hessians get. Reference: CHOLMOD factoring
+    // S = P (A + shift I) P^T in one call, in its natural order, with the same P; the modified solve written out.
+    // The parts' pivots are CHOLMOD's bit for bit, the separator's to round-off (summed in another order), and the
+    // factor does not depend on the thread count.
+    const int m = 40, n = m * m;
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) {
+            const int k = i * m + j;
+            t.emplace_back(k, k, 4.1 + 0.3 * std::sin(1.7 * k) - ((i * 5 + j * 3) % 17 == 0 ? 6.0 : 0.0));
+            if (j + 1 < m) t.emplace_back(k, k + 1, -1 + 0.1 * std::cos(k));
+            if (i + 1 < m) t.emplace_back(k, k + m, -1 + 0.1 * std::sin(2.3 * k));
+            if (i + 2 < m && j + 1 < m) t.emplace_back(k, k + 2 * m + 1, 0.2);
+        }
+    Eigen::SparseMatrix<double> U(n, n);
+    U.setFromTriplets(t.begin(), t.end());
+    U.makeCompressed();
+    Eigen::VectorXd b(n);
+    for (int i = 0; i < n; ++i) b[i] = std::sin(0.61 * i + 0.3);
+    const double shift = 1e-3, floor = 1e-6;
+
+    CholmodLDL ldl(100);
+    set_thread_count(1);
+    REQUIRE(ldl.factorize(U, shift));
+    const Eigen::VectorXd x1 = ldl.solve_modified(b, floor);
+    const Eigen::VectorXd d1 = ldl.pivots();
+    const int negative = ldl.negative_pivots();
+    set_thread_count(2);
+    REQUIRE(ldl.factorize(U, shift));
+    const Eigen::VectorXd x2 = ldl.solve_modified(b, floor);
+    const Eigen::VectorXd d2 = ldl.pivots();
+    set_thread_count(0);
+    const int a = ldl.split_a(), s = ldl.split_b();
+    REQUIRE(a > n / 4);
+    REQUIRE(s - a > n / 4);
+    REQUIRE(s < n);
+    // The parts are independent: no entry of U between a row eliminated in [0, a) and one in [a, s).
+    const std::vector<int>& P = ldl.order();
+    std::vector<int> pinv(n);
+    for (int k = 0; k < n; ++k) pinv[P[k]] = k;
+    int coupled = 0;
+    for (int c = 0; c < n; ++c)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(U, c); it; ++it) {
+            const int u = pinv[it.row()], v = pinv[c];
+            coupled += (u < a && v >= a && v < s) || (v < a && u >= a && u < s);
+        }
+    CHECK(coupled == 0);
+
+    // Reference: S = P U P^T (upper), CHOLMOD in its natural order, one call.
+    std::vector<Eigen::Triplet<double>> ts;
+    for (int c = 0; c < n; ++c)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(U, c); it; ++it) {
+            const int u = pinv[it.row()], v = pinv[c];
+            ts.emplace_back(std::min(u, v), std::max(u, v), it.value());
+        }
+    Eigen::SparseMatrix<double> S(n, n);
+    S.setFromTriplets(ts.begin(), ts.end());
+    S.makeCompressed();
+    cholmod_common c;
+    cholmod_start(&c);
+    c.supernodal = CHOLMOD_SIMPLICIAL, c.final_ll = 0, c.print = 0;
+    c.nmethods = 1, c.method[0].ordering = CHOLMOD_NATURAL, c.postorder = 0;
+    cholmod_sparse A{};
+    A.nrow = A.ncol = n, A.nzmax = S.nonZeros();
+    A.p = S.outerIndexPtr(), A.i = S.innerIndexPtr(), A.x = S.valuePtr();
+    A.stype = 1, A.itype = CHOLMOD_INT, A.xtype = CHOLMOD_REAL, A.dtype = CHOLMOD_DOUBLE, A.sorted = 1, A.packed = 1;
+    cholmod_factor* L = cholmod_analyze(&A, &c);
+    REQUIRE(L);
+    double beta[2] = {shift, 0};
+    REQUIRE(cholmod_factorize_p(&A, beta, nullptr, 0, L, &c));
+    REQUIRE(L->minor == L->n);
+    Eigen::VectorXd v(n);
+    for (int k = 0; k < n; ++k) v[k] = b[P[k]];
+    auto apply = [&](int sys) {
+        cholmod_dense B{};
+        B.nrow = B.d = B.nzmax = n, B.ncol = 1, B.x = v.data(), B.xtype = CHOLMOD_REAL, B.dtype = CHOLMOD_DOUBLE;
+        cholmod_dense* X = cholmod_solve(sys, L, &B, &c);
+        REQUIRE(X);
+        std::copy(static_cast<double*>(X->x), static_cast<double*>(X->x) + n, v.data());
+        cholmod_free_dense(&X, &c);
+    };
+    apply(CHOLMOD_L);
+    const double* Lx = static_cast<const double*>(L->x);
+    const int* Lp = static_cast<const int*>(L->p);
+    int ref_negative = 0, part_differ = 0;
+    double sep_error = 0;
+    for (int j = 0; j < n; ++j) {
+        ref_negative += Lx[Lp[j]] < 0;
+        if (j < s) part_differ += d1[j] != Lx[Lp[j]];
+        else sep_error = std::max(sep_error, std::abs(d1[j] - Lx[Lp[j]]) / std::abs(Lx[Lp[j]]));
+        v[j] /= std::max(std::abs(Lx[Lp[j]]), floor);
+    }
+    apply(CHOLMOD_Lt);
+    cholmod_free_factor(&L, &c);
+    cholmod_finish(&c);
+    Eigen::VectorXd xr(n);
+    for (int k = 0; k < n; ++k) xr[P[k]] = v[k];
+    REQUIRE(ref_negative > 0);
+    CHECK(negative == ref_negative);
+    CHECK(part_differ == 0);
+    CHECK(sep_error < 1e-12);
+    CHECK((x1 - xr).norm() <= 1e-10 * xr.norm());
+    int threads_differ = 0;
+    for (int i = 0; i < n; ++i) threads_differ += (x1[i] != x2[i]) + (d1[i] != d2[i]);
+    CHECK(threads_differ == 0);
+    // Inertia (Sylvester): as many negative pivots as negative eigenvalues of U + shift I.
+    Eigen::MatrixXd dense = Eigen::MatrixXd(U);
+    dense.triangularView<Eigen::StrictlyLower>() = dense.transpose();
+    dense.diagonal().array() += shift;
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(dense, Eigen::EigenvaluesOnly);
+    CHECK(negative == (es.eigenvalues().array() < 0).count());
 }

@@ -245,6 +245,14 @@ TEST_CASE("active set: a bridge set that repeats is reported as cycling", "[wet]
     CHECK(r.events.moves >= 3);
     CHECK(r.cycles_broken == 0);
 
+    // The freeze budget grows with the set: one more per bridges_per_freeze bridges (here 1 per bridge).
+    Scripted solver1({moved(e, q0, 1, -2, 0), moved(e, q0, 1, -1, 0)}, {});
+    Eigen::VectorXd q1 = q0;
+    opt.bridges_per_freeze = 1;
+    const ActiveSetResult r1 = relax_wet(e, I2, p, wet_crossings(net, m, m.x, m.box.B0(), {}), solver1, q1, opt);
+    CHECK(r1.cycles_broken == 1);
+    CHECK(r1.cycling);
+
     // By default the repeat is broken by freezing the pair's bridge; this stand-in solver still never reaches an
     // equilibrium (it alternates whatever the energy), so the loop ends cycling after the frozen round repeats.
     Scripted solver2({moved(e, q0, 1, -2, 0), moved(e, q0, 1, -1, 0)}, {});

@@ -13,12 +13,22 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <vector>
 
 namespace fibernet {
 
+// Large matrices (at least split_min rows) are ordered for two threads instead (docs/benchmarks.md, "First session
+// of 2026-11-25"): a vertex separator S splits the graph of H into parts A and B with no entry between them (METIS's
+// bisection through cholmod_bisect), each part is bisected once more, and CAMD orders every part within the
+// constraint [A's parts][B's parts][S]. Rows of A and of B then depend only on their own part: two threads compute
+// them, and each its part's share of the separator's rows, and one thread finishes the separator (split_ldl.hpp).
+// The parts' rows are CHOLMOD's arithmetic exactly, the separator's differ in the last bits (the same terms summed in
+// another order), and the factor is the same on any number of threads. Late in a 1e4-fiber wet run the two-level
+// order also has 13 % fewer flops than AMD.
 class CholmodLDL {
 public:
-    CholmodLDL();
+    static constexpr int kSplitMin = 20000;
+    explicit CholmodLDL(int split_min = kSplitMin);
     ~CholmodLDL();
     CholmodLDL(const CholmodLDL&) = delete;
     CholmodLDL& operator=(const CholmodLDL&) = delete;
@@ -26,6 +36,13 @@ public:
     // Symbolic analysis of an upper-triangular CSC pattern (values ignored).
     void analyze(const Eigen::SparseMatrix<double>& upper);
     bool analyzed() const;
+    // The analyzed order's independent row ranges [0, a) and [a, b) (factored at the same time); a = b = 0: none.
+    int split_a() const;
+    int split_b() const;
+    // The analyzed elimination order (order()[k]: the row of H eliminated k-th), and the last factorization's pivots
+    // D in that order.
+    const std::vector<int>& order() const;
+    Eigen::VectorXd pivots() const;
     // Numeric LDL^T of H + shift I (H with the analyzed pattern). False on a zero or non-finite pivot.
     bool factorize(const Eigen::SparseMatrix<double>& upper, double shift = 0.0);
     // Pivots of the last factorization that were negative, and the smallest one.

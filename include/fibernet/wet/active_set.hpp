@@ -17,8 +17,8 @@
 //            twice the angle and the distance).
 // The loop stops when q is an equilibrium of the updated set (stable: its gradient is no larger than the one the solver
 // accepted, so moves and locks, which leave the energy unchanged, need no new solve), when a bridge set repeats an
-// earlier round's more than max_freezes times (cycling, reported, the last state kept), when the solver fails, or after
-// max_rounds. A repeat is first broken: the fiber pairs whose bridges toggle are frozen (their bridges kept as they
+// earlier round's more than max_freezes + bridges / bridges_per_freeze times (cycling, reported, the last state kept),
+// when the solver fails, or after max_rounds. A repeat is first broken: the fiber pairs whose bridges toggle are frozen (their bridges kept as they
 // are, no new ones) and the rounds go on, so the result is an equilibrium with a set that obeys the rules everywhere
 // but on those pairs (counted: cycles_broken, frozen_pairs). A solve that
 // hits its iteration limit is not a failure: the set is updated and the next round continues from there. While the
@@ -68,7 +68,8 @@ struct ActiveSetOptions {
     double contact_distance = 0;  // seed units; 0: the fiber diameter 2 r = 2 ls / a
     double contact_angle_deg = 10;
     bool verbose = false;         // one progress line per round on stderr
-    int max_freezes = 5;          // cycles broken by freezing their fiber pairs before cycling is final
+    int max_freezes = 5;          // cycles broken by freezing their fiber pairs before cycling is final,
+    int bridges_per_freeze = 2000;  // and one more per this many bridges: a large network cycles in more places
     double move_margin = 0.1;     // a bridge moves once its crossing is this fraction of the blend half-width past a node
 };
 

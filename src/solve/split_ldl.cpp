@@ -1,0 +1,174 @@
+#include "split_ldl.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "fibernet/util/parallel.hpp"
+
+namespace fibernet::detail {
+
+void SplitLDL::setup(int n, int a, int b, std::vector<int> parent) {
+    n_ = n, a_ = a, b_ = b;
+    parent_ = std::move(parent);
+    for (Part& p : part_) {
+        p.w.assign(n, 0.0);
+        p.flag.assign(n, -1);
+        p.stack.assign(n, 0);
+        p.mark.assign(n - b, -1);
+    }
+    ws_.assign(n, 0.0);
+    fs_.assign(n, -1);
+    ss_.assign(n, 0);
+}
+
+void SplitLDL::part_rows(int t, const cholmod_sparse& S, double beta, cholmod_factor& L) {
+    Part& w = part_[t];
+    const int r0 = t == 0 ? 0 : a_, r1 = t == 0 ? a_ : b_, n = n_, b = b_;
+    const int* Sp = static_cast<const int*>(S.p);
+    const int* Si = static_cast<const int*>(S.i);
+    const double* Sx = static_cast<const double*>(S.x);
+    const int* Lp = static_cast<const int*>(L.p);
+    int* Li = static_cast<int*>(L.i);
+    int* Lnz = static_cast<int*>(L.nz);
+    double* Lx = static_cast<double*>(L.x);
+    const int* parent = parent_.data();
+    double* W = w.w.data();
+    int* flag = w.flag.data();
+    int* stack = w.stack.data();
+    std::fill(flag + r0, flag + r1, -1);
+    std::fill(w.mark.begin(), w.mark.end(), -1);
+    w.u_start.assign(1, 0);
+    w.u_row.clear(), w.u_val.clear(), w.dk.clear();
+    w.ok = true;
+    // Rows of the part: t_cholmod_rowfac.c's loop for a symmetric upper S, LDL^T, with the elimination tree given.
+    for (int k = r0; k < r1; ++k) {
+        int top = n;
+        flag[k] = k;
+        for (int p = Sp[k]; p < Sp[k + 1]; ++p) {
+            const int i = Si[p];
+            if (i > k) break;
+            W[i] = Sx[p];
+            int len = 0;
+            for (int j = i; j >= 0 && j < k && flag[j] != k; j = parent[j]) stack[len++] = j, flag[j] = k;
+            while (len > 0) stack[--top] = stack[--len];
+        }
+        double dk = W[k] + beta;
+        W[k] = 0;
+        for (int s = top; s < n; ++s) {
+            const int i = stack[s];
+            const double y = W[i];
+            W[i] = 0;
+            int p = Lp[i];
+            const int pend = p + Lnz[i];
+            const double di = Lx[p];
+            for (++p; p < pend; ++p) W[Li[p]] -= Lx[p] * y;
+            const double lx = y / di;
+            dk -= lx * y;
+            Li[pend] = k, Lx[pend] = lx, ++Lnz[i];
+        }
+        Li[Lp[k]] = k, Lx[Lp[k]] = dk;
+        if (dk == 0) {
+            w.ok = false;
+            return;
+        }
+    }
+    // The part's share of each separator row: the solve over its own columns, from column k's entries in its rows.
+    // Updates that reach separator rows (all below k) are kept per row for separator_rows().
+    for (int k = b; k < n; ++k) {
+        int top = n;
+        for (int p = Sp[k]; p < Sp[k + 1]; ++p) {
+            const int i = Si[p];
+            if (i < r0) continue;
+            if (i >= r1) break;
+            W[i] = Sx[p];
+            int len = 0;
+            for (int j = i; j >= 0 && j < r1 && flag[j] != k; j = parent[j]) stack[len++] = j, flag[j] = k;
+            while (len > 0) stack[--top] = stack[--len];
+        }
+        double dk = 0;
+        for (int s = top; s < n; ++s) {
+            const int i = stack[s];
+            const double y = W[i];
+            W[i] = 0;
+            int p = Lp[i];
+            const int pend = p + Lnz[i];
+            const double di = Lx[p];
+            for (++p; p < pend; ++p) {
+                const int r = Li[p];
+                if (r >= b && w.mark[r - b] != k) w.mark[r - b] = k, w.touched.push_back(r);
+                W[r] -= Lx[p] * y;
+            }
+            const double lx = y / di;
+            dk -= lx * y;
+            Li[pend] = k, Lx[pend] = lx, ++Lnz[i];
+        }
+        for (const int r : w.touched) w.u_row.push_back(r), w.u_val.push_back(W[r]), W[r] = 0;
+        w.touched.clear();
+        w.u_start.push_back(static_cast<int>(w.u_row.size()));
+        w.dk.push_back(dk);
+    }
+}
+
+bool SplitLDL::separator_rows(const cholmod_sparse& S, double beta, cholmod_factor& L) {
+    const int n = n_, b = b_;
+    const int* Sp = static_cast<const int*>(S.p);
+    const int* Si = static_cast<const int*>(S.i);
+    const double* Sx = static_cast<const double*>(S.x);
+    const int* Lp = static_cast<const int*>(L.p);
+    int* Li = static_cast<int*>(L.i);
+    int* Lnz = static_cast<int*>(L.nz);
+    double* Lx = static_cast<double*>(L.x);
+    const int* parent = parent_.data();
+    double* W = ws_.data();
+    int* flag = fs_.data();
+    int* stack = ss_.data();
+    std::fill(flag + b, flag + n, -1);
+    for (int k = b; k < n; ++k) {
+        int top = n;
+        // The reach in S from the row's start nodes: column k's entries in S and the separator rows the parts updated
+        // (the first separator ancestor of every part node in the row's reach is among those).
+        auto visit = [&](int i) {
+            int len = 0;
+            for (int j = i; j >= 0 && j < k && flag[j] != k; j = parent[j]) stack[len++] = j, flag[j] = k;
+            while (len > 0) stack[--top] = stack[--len];
+        };
+        for (int p = Sp[k]; p < Sp[k + 1]; ++p) {
+            const int i = Si[p];
+            if (i < b) continue;
+            if (i > k) break;
+            W[i] = Sx[p];
+            visit(i);
+        }
+        for (const Part& w : part_)
+            for (int u = w.u_start[k - b]; u < w.u_start[k - b + 1]; ++u) W[w.u_row[u]] += w.u_val[u], visit(w.u_row[u]);
+        double dk = W[k] + beta;
+        W[k] = 0;
+        dk += part_[0].dk[k - b];
+        dk += part_[1].dk[k - b];
+        for (int s = top; s < n; ++s) {
+            const int i = stack[s];
+            const double y = W[i];
+            W[i] = 0;
+            int p = Lp[i];
+            const int pend = p + Lnz[i];
+            const double di = Lx[p];
+            for (++p; p < pend; ++p) W[Li[p]] -= Lx[p] * y;
+            const double lx = y / di;
+            dk -= lx * y;
+            Li[pend] = k, Lx[pend] = lx, ++Lnz[i];
+        }
+        Li[Lp[k]] = k, Lx[Lp[k]] = dk;
+        if (dk == 0) return false;
+    }
+    return true;
+}
+
+bool SplitLDL::factorize(const cholmod_sparse& S, double beta, cholmod_factor& L, int threads) {
+    std::fill(static_cast<int*>(L.nz), static_cast<int*>(L.nz) + n_, 1);  // every column holds its pivot only
+    parallel_ranges(2, std::min(2, threads), [&](size_t lo, size_t hi) {
+        for (size_t t = lo; t < hi; ++t) part_rows(static_cast<int>(t), S, beta, L);
+    });
+    return part_[0].ok && part_[1].ok && separator_rows(S, beta, L);
+}
+
+}  // namespace fibernet::detail
