@@ -155,8 +155,11 @@ void CholmodLDL::analyze(const Eigen::SparseMatrix<double>& upper) {
     if (!m.L) throw std::runtime_error("CHOLMOD symbolic analysis failed (status " + std::to_string(m.c.status) + ")");
     if (m.b > 0) {
         std::vector<int> parent(n);
-        if (!cholmod_etree(&S, parent.data(), &m.c))
+        if (!cholmod_etree(&S, parent.data(), &m.c)) {
+            cholmod_free_factor(&m.L, &m.c);  // not analyzed: the next factorize() analyzes again
+            m.a = m.b = 0;
             throw std::runtime_error("CHOLMOD elimination tree failed (status " + std::to_string(m.c.status) + ")");
+        }
         m.split.setup(n, m.a, m.b, std::move(parent));
     }
 }
@@ -171,6 +174,7 @@ bool CholmodLDL::factorize(const Eigen::SparseMatrix<double>& upper, double shif
     cholmod_sparse S = m.S.view();
     double beta[2] = {shift, 0.0};
     m.c.status = CHOLMOD_OK;
+    m.ok = false, m.negative = 0, m.min_pivot = std::numeric_limits<double>::infinity();
     int r = 0;
     if (m.b > 0) {
         // The parts' rows on two threads, then the separator's (split_ldl.hpp), into CHOLMOD's numeric factor.

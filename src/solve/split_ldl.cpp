@@ -35,8 +35,12 @@ void SplitLDL::part_rows(int t, const cholmod_sparse& S, double beta, cholmod_fa
     double* W = w.w.data();
     int* flag = w.flag.data();
     int* stack = w.stack.data();
+    // Fresh workspace each time (O(n), against the factorization's O(flops)): a call that stopped early, at a zero
+    // pivot or an exception, leaves entries behind.
+    std::fill(w.w.begin(), w.w.end(), 0.0);
     std::fill(flag + r0, flag + r1, -1);
     std::fill(w.mark.begin(), w.mark.end(), -1);
+    w.touched.clear();
     w.u_start.assign(1, 0);
     w.u_row.clear(), w.u_val.clear(), w.dk.clear();
     w.ok = true;
@@ -122,6 +126,7 @@ bool SplitLDL::separator_rows(const cholmod_sparse& S, double beta, cholmod_fact
     double* W = ws_.data();
     int* flag = fs_.data();
     int* stack = ss_.data();
+    std::fill(ws_.begin(), ws_.end(), 0.0);
     std::fill(flag + b, flag + n, -1);
     for (int k = b; k < n; ++k) {
         int top = n;

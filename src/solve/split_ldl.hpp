@@ -10,8 +10,9 @@
 // separator row's solve that runs over its own columns (its entries of L(k, part) and the updates they send to the
 // separator's rows and pivot), and one thread then finishes the separator rows from those updates.
 //
-// The rows of A and B are CHOLMOD's arithmetic exactly (same operations, same order); a separator row sums the same
-// terms in another order (A's, then B's, then S's), so its entries differ from CHOLMOD's in the last bits. The result
+// The rows of A and B, and the separator rows' entries in A's and B's columns, are CHOLMOD's arithmetic exactly (same
+// operations, same order); a separator row's pivot and entries in S's columns sum the same terms in another order
+// (A's, then B's, then S's), so they differ from CHOLMOD's in the last bits. The result
 // does not depend on the number of threads. L is CHOLMOD's simplicial numeric factor (columns allocated by its
 // symbolic analysis, which bounds every column's entries), so CHOLMOD's solves use it as is.
 #include <cholmod.h>

@@ -233,6 +233,9 @@ TEST_CASE("cholmod_ldl: the two-thread order factors as CHOLMOD would in that or
     const double shift = 1e-3, floor = 1e-6;
 
     CholmodLDL ldl(100);
+    struct RestoreThreads {
+        ~RestoreThreads() { set_thread_count(0); }
+    } restore_threads;
     set_thread_count(1);
     REQUIRE(ldl.factorize(U, shift));
     const Eigen::VectorXd x1 = ldl.solve_modified(b, floor);
@@ -242,7 +245,6 @@ TEST_CASE("cholmod_ldl: the two-thread order factors as CHOLMOD would in that or
     REQUIRE(ldl.factorize(U, shift));
     const Eigen::VectorXd x2 = ldl.solve_modified(b, floor);
     const Eigen::VectorXd d2 = ldl.pivots();
-    set_thread_count(0);
     const int a = ldl.split_a(), s = ldl.split_b();
     REQUIRE(a > n / 4);
     REQUIRE(s - a > n / 4);
@@ -322,4 +324,22 @@ TEST_CASE("cholmod_ldl: the two-thread order factors as CHOLMOD would in that or
     dense.diagonal().array() += shift;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(dense, Eigen::EigenvaluesOnly);
     CHECK(negative == (es.eigenvalues().array() < 0).count());
+
+    // A zero pivot in either part (a coordinate with zero couplings and diagonal -shift: D = 0 exactly) fails the
+    // factorization, on both thread counts; the next factorization of U is the same as before, bit for bit.
+    for (const int pos : {a / 2, a + (s - a) / 2})
+        for (const int threads : {1, 2}) {
+            set_thread_count(threads);
+            const int z = P[pos];
+            Eigen::SparseMatrix<double> Z = U;
+            for (int c = 0; c < n; ++c)
+                for (Eigen::SparseMatrix<double>::InnerIterator it(Z, c); it; ++it)
+                    if (it.row() == z || c == z) it.valueRef() = it.row() == c ? -shift : 0.0;
+            CHECK_FALSE(ldl.factorize(Z, shift));
+            REQUIRE(ldl.factorize(U, shift));
+            const Eigen::VectorXd d3 = ldl.pivots(), x3 = ldl.solve_modified(b, floor);
+            int again = 0;
+            for (int i = 0; i < n; ++i) again += (x3[i] != x1[i]) + (d3[i] != d1[i]);
+            CHECK(again == 0);
+        }
 }
