@@ -10,9 +10,12 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <numeric>
 #include <set>
 #include <utility>
 
+#include "fibernet/util/parallel.hpp"
 #include "fibernet/wet/wet_region.hpp"
 #include "fibernet/wet/wetting.hpp"
 
@@ -429,6 +432,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
     std::vector<char> region;  // non-empty: the next round is local, on these nodes
     ElementIncidence inc;      // of the energy the next local round solves (segment and hinge rows built once)
     std::unique_ptr<WetEnergy> next;
+    std::vector<std::unique_ptr<Solver>> part_solvers;  // local rounds: a solver per thread solving parts
     // max_rounds bounds the global rounds; local ones are cheap and many (1253 of 1341 at 1e4 fibers), bounded by
     // 10 x max_rounds in all.
     int global_rounds = 0;
@@ -452,17 +456,54 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             const auto parts = region_parts(W, inc, region);
             r.seconds_local_setup += now() - t0;
             so.warm_start = restore.saved.warm_start;  // each part adapts its own shift
+            // The parts on FIBERNET_THREADS threads, largest first: they share no element and each writes only its
+            // own nodes (of q and of the shared state), so no part's solve depends on another's. The last part (in
+            // the parts' order) is solved by the caller's solver, the others by solvers of the threads: a global
+            // round that resumes a cut one warm-starts from the caller's solver's last shift, which must stay that
+            // of the last part, as when the parts were solved one after another (solved by solvers of their own, a
+            // 1000-fiber run did not settle in 1000 global rounds; docs/benchmarks.md). So the round is the same bit
+            // for bit on any number of threads. Results are gathered in the parts' order. (One thread with Newton's
+            // verbose lines, which would interleave.)
+            const int threads = so.verbose ? 1 : std::max(1, std::min(thread_count(), static_cast<int>(parts.size())));
+            while (static_cast<int>(part_solvers.size()) < threads) part_solvers.push_back(make_solver(solver.name(), so));
+            std::vector<Solver*> pool;
+            for (int k = 0; k < threads; ++k) part_solvers[k]->options() = so, pool.push_back(part_solvers[k].get());
+            std::mutex pool_mutex;
+            std::vector<size_t> by_size(parts.size());
+            std::iota(by_size.begin(), by_size.end(), size_t{0});
+            std::stable_sort(by_size.begin(), by_size.end(),
+                             [&](size_t x, size_t y) { return parts[x].size() > parts[y].size(); });
+            std::vector<SolveResult> results(parts.size());
+            std::vector<int> sizes(parts.size(), 0);
+            std::vector<double> setup(parts.size(), 0.0);
+            parallel_blocks(parts.size(), threads, 1, [] {}, [&](size_t lo, size_t hi) {
+                Solver* mine = nullptr;
+                {
+                    std::lock_guard<std::mutex> lock(pool_mutex);
+                    mine = pool.back();
+                    pool.pop_back();
+                }
+                for (size_t k = lo; k < hi; ++k) {
+                    const size_t i = by_size[k];
+                    const double ts = now();
+                    WetRegion R(W, state, parts[i], inc);
+                    setup[i] = now() - ts;
+                    sizes[i] = R.size();
+                    if (R.size() == 0) continue;
+                    Eigen::VectorXd qa = R.restrict(q);
+                    results[i] = (i + 1 == parts.size() ? static_cast<Solver&>(solver) : *mine).minimize(R, qa);
+                    R.embed(qa, q);
+                }
+                std::lock_guard<std::mutex> lock(pool_mutex);
+                pool.push_back(mine);
+            });
             SolveResult all;
             all.status = SolveStatus::Converged, all.solver = solver.name();
-            for (const auto& nodes : parts) {
-                const double ts = now();
-                WetRegion R(W, state, nodes, inc);
-                r.seconds_local_setup += now() - ts;
-                if (R.size() == 0) continue;
-                region_size += R.size(), ++region_parts_n;
-                Eigen::VectorXd qa = R.restrict(q);
-                const SolveResult p = solver.minimize(R, qa);
-                R.embed(qa, q);
+            for (size_t i = 0; i < parts.size(); ++i) {
+                r.seconds_local_setup += setup[i];
+                if (sizes[i] == 0) continue;
+                region_size += sizes[i], ++region_parts_n;
+                const SolveResult& p = results[i];
                 all.iterations += p.iterations, all.factorizations += p.factorizations;
                 all.ldl_retries += p.ldl_retries, all.evaluations += p.evaluations;
                 all.timings += p.timings;

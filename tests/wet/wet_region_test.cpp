@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "fibernet/solve/newton.hpp"
+#include "fibernet/util/parallel.hpp"
 #include "fibernet/wet/active_set.hpp"
 #include "fibernet/wet/wet_region.hpp"
 #include "wet_fixtures.hpp"
@@ -199,6 +200,22 @@ TEST_CASE("wet relaxation: local rounds end at an equilibrium of the whole netwo
     }
     CHECK(static_cast<int>(r.frozen.size()) == r.frozen_pairs);
     CHECK(update_bridges(e, q, Eigen::Matrix2d::Identity(), b, {}, &r.frozen).total() == 0);  // but on frozen pairs
+
+    // A local round's parts are solved on several threads (the last one by the caller's solver, whose shift a later
+    // global round resumes): the same run, bit for bit, on 1 and 3 threads.
+    struct RestoreThreads {
+        ~RestoreThreads() { set_thread_count(0); }
+    } restore_threads;
+    for (const int threads : {1, 3}) {
+        set_thread_count(threads);
+        Eigen::VectorXd qt = e.dofs(m.x);
+        auto st = make_solver("newton", so);
+        const ActiveSetResult rt = relax_wet(e, Eigen::Matrix2d::Identity(), p, initial, *st, qt, opt);
+        INFO(threads << " thread(s): " << rt.message);
+        CHECK(rt.rounds == r.rounds);
+        CHECK(rt.local_iterations == r.local_iterations);
+        CHECK((qt - q).cwiseAbs().maxCoeff() == 0.0);
+    }
 }
 
 TEST_CASE("wet region: crossing and contact search from flagged segments finds the full search's pairs", "[wet][region]") {
