@@ -117,31 +117,29 @@ int main(int argc, char** argv) {
     // The simplicial LDL^T of the indefinite H + 1e-8 mean diag (Newton's first rung) and its modified solve: in
     // CholmodLDL's two-thread order (the default for large matrices), and with CHOLMOD's own order on one thread
     // (split_min above the size: the wrapper before 2026-11-25).
-    double t_ldl_an = 1e300, t_ldl = 1e300, t_ldl_solve = 1e300, t_one_an = 1e300, t_one = 1e300;
-    int negative = 0, split_a = 0, split_b = 0;
-    for (int r = 0; r < reps; ++r) {
-        CholmodLDL one(1 << 30);
-        auto t0 = Clock::now();
-        one.analyze(H);
-        t_one_an = std::min(t_one_an, seconds_since(t0));
-        t0 = Clock::now();
-        if (!one.factorize(H, 1e-8 * dm)) std::fprintf(stderr, "warning: LDL^T of H + 1e-8 mean diag failed\n");
-        t_one = std::min(t_one, seconds_since(t0));
-    }
-    for (int r = 0; r < reps; ++r) {
-        CholmodLDL ldl;
-        auto t0 = Clock::now();
-        ldl.analyze(H);
-        t_ldl_an = std::min(t_ldl_an, seconds_since(t0));
-        t0 = Clock::now();
-        if (!ldl.factorize(H, 1e-8 * dm)) std::fprintf(stderr, "warning: LDL^T of H + 1e-8 mean diag failed\n");
-        t_ldl = std::min(t_ldl, seconds_since(t0));
-        negative = ldl.negative_pivots();
-        split_a = ldl.split_a(), split_b = ldl.split_b();
-        t0 = Clock::now();
-        const Eigen::VectorXd d = ldl.solve_modified(g, 1e-8 * dm);
-        t_ldl_solve = std::min(t_ldl_solve, seconds_since(t0));
-    }
+    struct LdlTimes {
+        double analysis = 1e300, factorization = 1e300, solve = 1e300;  // min over the repetitions
+        int negative = 0, split_a = 0, split_b = 0;
+    };
+    auto time_ldl = [&](int split_min) {
+        LdlTimes t;
+        for (int r = 0; r < reps; ++r) {
+            CholmodLDL ldl(split_min);
+            auto t0 = Clock::now();
+            ldl.analyze(H);
+            t.analysis = std::min(t.analysis, seconds_since(t0));
+            t0 = Clock::now();
+            if (!ldl.factorize(H, 1e-8 * dm)) std::fprintf(stderr, "warning: LDL^T of H + 1e-8 mean diag failed\n");
+            t.factorization = std::min(t.factorization, seconds_since(t0));
+            t.negative = ldl.negative_pivots();
+            t.split_a = ldl.split_a(), t.split_b = ldl.split_b();
+            t0 = Clock::now();
+            const Eigen::VectorXd d = ldl.solve_modified(g, 1e-8 * dm);
+            t.solve = std::min(t.solve, seconds_since(t0));
+        }
+        return t;
+    };
+    const LdlTimes one = time_ldl(1 << 30), two = time_ldl(CholmodLDL::kSplitMin);
     // Orderings for the simplicial LDL^T, by CHOLMOD directly on H with the order of its own (so "default" is CHOLMOD
     // as the wrapper called it before it pre-permuted: compare its factorization_s with ldl_factorization_s).
     // early_nesdis: the NESDIS order of the first wet Hessian (wet_rounds > 0 only), node_nesdis: NESDIS of the node
@@ -229,6 +227,7 @@ int main(int argc, char** argv) {
                 "\"ldl_solve_s\": %.4f, \"ldl_negative_pivots\": %d, \"ldl_parts\": [%d, %d, %d], "
                 "\"ldl_one_thread_amd\": {\"analysis_s\": %.4f, \"factorization_s\": %.4f}, \"orderings\": {%s}}\n",
                 net.fibers.size(), static_cast<long>(H.rows()), static_cast<long>(H.nonZeros()), t_pattern, t_an, t_ok,
-                fail_ok ? "true" : "false", t_fail, t_ldl_an, t_ldl, t_ldl_solve, negative, split_a, split_b - split_a,
-                static_cast<int>(H.rows()) - split_b, t_one_an, t_one, ord_json.c_str());
+                fail_ok ? "true" : "false", t_fail, two.analysis, two.factorization, two.solve, two.negative, two.split_a,
+                two.split_b - two.split_a, static_cast<int>(H.rows()) - two.split_b, one.analysis, one.factorization,
+                ord_json.c_str());
 }

@@ -174,7 +174,7 @@ bool CholmodLDL::factorize(const Eigen::SparseMatrix<double>& upper, double shif
     cholmod_sparse S = m.S.view();
     double beta[2] = {shift, 0.0};
     m.c.status = CHOLMOD_OK;
-    m.ok = false, m.negative = 0, m.min_pivot = std::numeric_limits<double>::infinity();
+    m.ok = false, m.negative = 0, m.min_pivot = std::numeric_limits<double>::infinity();  // until this one succeeds
     int r = 0;
     if (m.b > 0) {
         // The parts' rows on two threads, then the separator's (split_ldl.hpp), into CHOLMOD's numeric factor.
@@ -186,18 +186,16 @@ bool CholmodLDL::factorize(const Eigen::SparseMatrix<double>& upper, double shif
     } else {
         r = cholmod_factorize_p(&S, beta, nullptr, 0, m.L, &m.c);
     }
-    const cholmod_factor* L = impl_->L;
-    impl_->ok = r && impl_->c.status == CHOLMOD_OK && L->minor == L->n && !L->is_ll && !L->is_super;
-    impl_->negative = 0;
-    impl_->min_pivot = std::numeric_limits<double>::infinity();
-    if (!impl_->ok) return false;
+    const cholmod_factor* L = m.L;
+    m.ok = r && m.c.status == CHOLMOD_OK && L->minor == L->n && !L->is_ll && !L->is_super;
+    if (!m.ok) return false;
     const double* x = static_cast<const double*>(L->x);
     const int* p = static_cast<const int*>(L->p);
     for (size_t j = 0; j < L->n; ++j) {
         const double d = x[p[j]];  // simplicial LDL^T: D_j is the first entry of column j
-        if (!std::isfinite(d) || d == 0) return impl_->ok = false;
-        impl_->negative += d < 0;
-        impl_->min_pivot = std::min(impl_->min_pivot, d);
+        if (!std::isfinite(d) || d == 0) return m.ok = false;
+        m.negative += d < 0;
+        m.min_pivot = std::min(m.min_pivot, d);
     }
     return true;
 }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "cholmod_fixtures.hpp"
 #include "fibernet/solve/cholmod_ldl.hpp"
 #include "fibernet/util/parallel.hpp"
 
@@ -133,58 +134,15 @@ TEST_CASE("cholmod_ldl: the pre-permuted factorization equals CHOLMOD's own bit 
     // CholmodLDL hands CHOLMOD S = P A P^T in its natural order instead of A with the order P (which CHOLMOD
     // transposes twice per factorization). Same order, same S: the same pivots and solves, exactly. Reference: CHOLMOD
     // on A itself, with its default analysis, and the modified solve written out with its permutation solves.
-    const int m = 12, n = m * m;
-    std::vector<Eigen::Triplet<double>> t;
-    for (int i = 0; i < m; ++i)
-        for (int j = 0; j < m; ++j) {
-            const int k = i * m + j;
-            t.emplace_back(k, k, 4.1 + 0.3 * std::sin(1.7 * k) - ((i * 5 + j * 3) % 13 == 0 ? 6.0 : 0.0));
-            if (j + 1 < m) t.emplace_back(k, k + 1, -1 + 0.1 * std::cos(k));
-            if (i + 1 < m) t.emplace_back(k, k + m, -1 + 0.1 * std::sin(2.3 * k));
-            if (i + 2 < m && j + 1 < m) t.emplace_back(k, k + 2 * m + 1, 0.2);  // a longer coupling: more fill
-        }
-    Eigen::SparseMatrix<double> U(n, n);
-    U.setFromTriplets(t.begin(), t.end());
-    U.makeCompressed();
+    const Eigen::SparseMatrix<double> U = test::grid(12, 4.1, 6.0);
+    const int n = static_cast<int>(U.rows());
     Eigen::VectorXd b(n);
     for (int i = 0; i < n; ++i) b[i] = std::sin(0.61 * i + 0.3);
     const double shift = 1e-3, floor = 1e-6;
-
-    cholmod_common c;
-    cholmod_start(&c);
-    c.supernodal = CHOLMOD_SIMPLICIAL, c.final_ll = 0, c.print = 0;
-    cholmod_sparse A{};
-    A.nrow = A.ncol = n, A.nzmax = U.nonZeros();
-    A.p = U.outerIndexPtr(), A.i = U.innerIndexPtr(), A.x = U.valuePtr();
-    A.stype = 1, A.itype = CHOLMOD_INT, A.xtype = CHOLMOD_REAL, A.dtype = CHOLMOD_DOUBLE, A.sorted = 1, A.packed = 1;
-    cholmod_factor* L = cholmod_analyze(&A, &c);
-    REQUIRE(L);
-    double beta[2] = {shift, 0};
-    REQUIRE(cholmod_factorize_p(&A, beta, nullptr, 0, L, &c));
-    REQUIRE(L->minor == L->n);
-    bool identity = true;
-    for (int k = 0; k < n; ++k) identity = identity && static_cast<int*>(L->Perm)[k] == k;
-    REQUIRE_FALSE(identity);  // a fill-reducing order: the case the pre-permutation is for
-    Eigen::VectorXd v = b;
-    int negative = 0;
-    auto apply = [&](int sys) {
-        cholmod_dense B{};
-        B.nrow = B.d = B.nzmax = n, B.ncol = 1, B.x = v.data(), B.xtype = CHOLMOD_REAL, B.dtype = CHOLMOD_DOUBLE;
-        cholmod_dense* X = cholmod_solve(sys, L, &B, &c);
-        REQUIRE(X);
-        std::copy(static_cast<double*>(X->x), static_cast<double*>(X->x) + n, v.data());
-        cholmod_free_dense(&X, &c);
-    };
-    apply(CHOLMOD_P), apply(CHOLMOD_L);
-    const double* Lx = static_cast<const double*>(L->x);
-    const int* Lp = static_cast<const int*>(L->p);
-    for (int j = 0; j < n; ++j) {
-        negative += Lx[Lp[j]] < 0;
-        v[j] /= std::max(std::abs(Lx[Lp[j]]), floor);
-    }
-    apply(CHOLMOD_Lt), apply(CHOLMOD_Pt);
-    cholmod_free_factor(&L, &c);
-    cholmod_finish(&c);
+    const test::CholmodReference ref(U, false, shift, floor, b);
+    REQUIRE_FALSE(ref.identity_order);  // a fill-reducing order: the case the pre-permutation is for
+    const int negative = ref.negative;
+    const Eigen::VectorXd& v = ref.x;
     REQUIRE(negative > 0);
 
     CholmodLDL ldl;
@@ -215,19 +173,8 @@ TEST_CASE("cholmod_ldl: the two-thread order factors as CHOLMOD would in that or
     // S = P (A + shift I) P^T in one call, in its natural order, with the same P; the modified solve written out.
     // The parts' pivots are CHOLMOD's bit for bit, the separator's to round-off (summed in another order), and the
     // factor does not depend on the thread count.
-    const int m = 40, n = m * m;
-    std::vector<Eigen::Triplet<double>> t;
-    for (int i = 0; i < m; ++i)
-        for (int j = 0; j < m; ++j) {
-            const int k = i * m + j;
-            t.emplace_back(k, k, 4.1 + 0.3 * std::sin(1.7 * k) - ((i * 5 + j * 3) % 17 == 0 ? 6.0 : 0.0));
-            if (j + 1 < m) t.emplace_back(k, k + 1, -1 + 0.1 * std::cos(k));
-            if (i + 1 < m) t.emplace_back(k, k + m, -1 + 0.1 * std::sin(2.3 * k));
-            if (i + 2 < m && j + 1 < m) t.emplace_back(k, k + 2 * m + 1, 0.2);
-        }
-    Eigen::SparseMatrix<double> U(n, n);
-    U.setFromTriplets(t.begin(), t.end());
-    U.makeCompressed();
+    const Eigen::SparseMatrix<double> U = test::grid(40, 4.1, 6.0, 17);
+    const int n = static_cast<int>(U.rows());
     Eigen::VectorXd b(n);
     for (int i = 0; i < n; ++i) b[i] = std::sin(0.61 * i + 0.3);
     const double shift = 1e-3, floor = 1e-6;
@@ -271,45 +218,18 @@ TEST_CASE("cholmod_ldl: the two-thread order factors as CHOLMOD would in that or
     Eigen::SparseMatrix<double> S(n, n);
     S.setFromTriplets(ts.begin(), ts.end());
     S.makeCompressed();
-    cholmod_common c;
-    cholmod_start(&c);
-    c.supernodal = CHOLMOD_SIMPLICIAL, c.final_ll = 0, c.print = 0;
-    c.nmethods = 1, c.method[0].ordering = CHOLMOD_NATURAL, c.postorder = 0;
-    cholmod_sparse A{};
-    A.nrow = A.ncol = n, A.nzmax = S.nonZeros();
-    A.p = S.outerIndexPtr(), A.i = S.innerIndexPtr(), A.x = S.valuePtr();
-    A.stype = 1, A.itype = CHOLMOD_INT, A.xtype = CHOLMOD_REAL, A.dtype = CHOLMOD_DOUBLE, A.sorted = 1, A.packed = 1;
-    cholmod_factor* L = cholmod_analyze(&A, &c);
-    REQUIRE(L);
-    double beta[2] = {shift, 0};
-    REQUIRE(cholmod_factorize_p(&A, beta, nullptr, 0, L, &c));
-    REQUIRE(L->minor == L->n);
-    Eigen::VectorXd v(n);
-    for (int k = 0; k < n; ++k) v[k] = b[P[k]];
-    auto apply = [&](int sys) {
-        cholmod_dense B{};
-        B.nrow = B.d = B.nzmax = n, B.ncol = 1, B.x = v.data(), B.xtype = CHOLMOD_REAL, B.dtype = CHOLMOD_DOUBLE;
-        cholmod_dense* X = cholmod_solve(sys, L, &B, &c);
-        REQUIRE(X);
-        std::copy(static_cast<double*>(X->x), static_cast<double*>(X->x) + n, v.data());
-        cholmod_free_dense(&X, &c);
-    };
-    apply(CHOLMOD_L);
-    const double* Lx = static_cast<const double*>(L->x);
-    const int* Lp = static_cast<const int*>(L->p);
-    int ref_negative = 0, part_differ = 0;
+    Eigen::VectorXd bp(n);
+    for (int k = 0; k < n; ++k) bp[k] = b[P[k]];
+    const test::CholmodReference ref(S, true, shift, floor, bp);
+    const int ref_negative = ref.negative;
+    int part_differ = 0;
     double sep_error = 0;
     for (int j = 0; j < n; ++j) {
-        ref_negative += Lx[Lp[j]] < 0;
-        if (j < s) part_differ += d1[j] != Lx[Lp[j]];
-        else sep_error = std::max(sep_error, std::abs(d1[j] - Lx[Lp[j]]) / std::abs(Lx[Lp[j]]));
-        v[j] /= std::max(std::abs(Lx[Lp[j]]), floor);
+        if (j < s) part_differ += d1[j] != ref.pivots[j];
+        else sep_error = std::max(sep_error, std::abs(d1[j] - ref.pivots[j]) / std::abs(ref.pivots[j]));
     }
-    apply(CHOLMOD_Lt);
-    cholmod_free_factor(&L, &c);
-    cholmod_finish(&c);
     Eigen::VectorXd xr(n);
-    for (int k = 0; k < n; ++k) xr[P[k]] = v[k];
+    for (int k = 0; k < n; ++k) xr[P[k]] = ref.x[k];
     REQUIRE(ref_negative > 0);
     CHECK(negative == ref_negative);
     CHECK(part_differ == 0);

@@ -4,30 +4,12 @@
 #include <cmath>
 #include <vector>
 
+#include "cholmod_fixtures.hpp"
 #include "fibernet/solve/cholmod_llt.hpp"
 
 using namespace fibernet;
 
-namespace {
-// Upper triangle of a 2D grid operator with a longer coupling (fill, and a fill-reducing order that is not the
-// identity); diagonal d0 + a small variation, minus `dip` at a few sites.
-Eigen::SparseMatrix<double> grid(int m, double d0, double dip) {
-    const int n = m * m;
-    std::vector<Eigen::Triplet<double>> t;
-    for (int i = 0; i < m; ++i)
-        for (int j = 0; j < m; ++j) {
-            const int k = i * m + j;
-            t.emplace_back(k, k, d0 + 0.3 * std::sin(1.7 * k) - ((i * 5 + j * 3) % 13 == 0 ? dip : 0.0));
-            if (j + 1 < m) t.emplace_back(k, k + 1, -1 + 0.1 * std::cos(k));
-            if (i + 1 < m) t.emplace_back(k, k + m, -1 + 0.1 * std::sin(2.3 * k));
-            if (i + 2 < m && j + 1 < m) t.emplace_back(k, k + 2 * m + 1, 0.2);
-        }
-    Eigen::SparseMatrix<double> U(n, n);
-    U.setFromTriplets(t.begin(), t.end());
-    U.makeCompressed();
-    return U;
-}
-}  // namespace
+using test::grid;
 
 TEST_CASE("cholmod_llt: solves H + shift I, one or several right-hand sides", "[cholmod_llt]") {
     const Eigen::SparseMatrix<double> U = grid(10, 4.6, 0.0);
