@@ -174,7 +174,11 @@ WetRegion::WetRegion(const WetEnergy& W, RegionState& state, const std::vector<i
         index(n, 3, hinge_idx_);
     }
     for (int e : bridges_) index(W.elements()[e].node, 8, bridge_idx_);
+}
 
+// The Hessian pattern on first use: a region built for its gradient only (gradient_rows) never needs it.
+const Eigen::SparseMatrix<double>& WetRegion::hessian_pattern() const {
+    if (pattern_built_) return pattern_;
     // Upper-triangular pattern over the region's coordinates, then each element's value slots.
     PatternBuilder builder(size());
     builder.add_elements(seg_idx_, 4), builder.add_elements(hinge_idx_, 6), builder.add_elements(bridge_idx_, 16);
@@ -183,6 +187,8 @@ WetRegion::WetRegion(const WetEnergy& W, RegionState& state, const std::vector<i
     element_slots(pattern_, seg_idx_, 4, seg_slot_);
     element_slots(pattern_, hinge_idx_, 6, hinge_slot_);
     element_slots(pattern_, bridge_idx_, 16, bridge_slot_);
+    pattern_built_ = true;
+    return pattern_;
 }
 
 Eigen::VectorXd WetRegion::restrict(const Eigen::VectorXd& q) const {
@@ -204,7 +210,7 @@ double WetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::Spa
     if (g) g->setZero(size());
     double* hv = nullptr;
     if (H) {
-        if (H->nonZeros() != pattern_.nonZeros()) throw std::logic_error("Hessian lacks the region's pattern");
+        if (H->nonZeros() != hessian_pattern().nonZeros()) throw std::logic_error("Hessian lacks the region's pattern");
         hv = H->valuePtr();
         std::fill(hv, hv + H->nonZeros(), 0.0);
     }
@@ -243,6 +249,69 @@ double WetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::Spa
         }
     }
     return E;
+}
+
+void gradient_rows(const WetEnergy& W, const ElementIncidence& inc, const Eigen::VectorXd& q,
+                   const std::vector<char>& nodes, Eigen::VectorXd& g) {
+    const NetworkEnergy& dry = W.dry();
+    const Model& m = dry.model();
+    const Eigen::Matrix2d& F = W.F();
+    // The elements at the flagged nodes, each once, in index order (as WetRegion gathers them, without its index
+    // tables: here each element's entries go straight to g).
+    std::vector<int> segs, hinges, bridges;
+    auto gather = [&](int v, const std::vector<int>& start, const std::vector<int>& list, std::vector<int>& out) {
+        out.insert(out.end(), list.begin() + start[v], list.begin() + start[v + 1]);
+    };
+    for (int v = 0; v < static_cast<int>(nodes.size()); ++v) {
+        if (!nodes[v]) continue;
+        for (int c = 0; c < 2; ++c)
+            if (dry.dof(v, c) >= 0) g[dry.dof(v, c)] = 0;
+        gather(v, inc.seg_start, inc.seg, segs), gather(v, inc.hinge_start, inc.hinge, hinges);
+        gather(v, inc.bridge_start, inc.bridge, bridges);
+    }
+    for (auto* list : {&segs, &hinges, &bridges}) {
+        std::sort(list->begin(), list->end());
+        list->erase(std::unique(list->begin(), list->end()), list->end());
+    }
+    // An element's local coordinate a adds to g where its node is flagged, in the order a = 0, 1, ... (as
+    // NetworkEnergy::evaluate and WetEnergy::eval add them).
+    auto add = [&](const int* n, int M, const double* ge) {
+        for (int a = 0; a < M; ++a) {
+            const int v = n[a / 2];
+            if (v < 0 || !nodes[v]) continue;
+            const int r = dry.dof(v, a % 2);
+            if (r >= 0) g[r] += ge[a];
+        }
+    };
+    const Eigen::VectorXd u = dry.displacements(q, F);
+    Eigen::Vector4d g4;
+    for (int e : segs) {
+        dry.segment_term(e, u, F, &g4, nullptr, false);
+        const int n[2] = {m.segments[e].i, m.segments[e].j};
+        add(n, 4, g4.data());
+    }
+    Eigen::Matrix<double, 6, 1> g6;
+    for (int e : hinges) {
+        dry.hinge_term(e, u, F, &g6, nullptr, false);
+        const int n[3] = {m.hinges[e].i, m.hinges[e].j, m.hinges[e].k};
+        add(n, 6, g6.data());
+    }
+    if (bridges.empty()) return;
+    const Eigen::VectorXd x = dry.positions(q, F);
+    const Eigen::Matrix2d B = F * m.box.B0();
+    Vector16d g16;
+    for (int k : bridges) {
+        const BridgeElement& e = W.elements()[k];
+        bridge_element_energy(e, element_coordinates(e, x, B), W.params().beta, W.params().law, &g16, nullptr, false);
+        add(e.node, 16, g16.data());
+    }
+}
+
+void update_gradient(const WetEnergy& W, const ElementIncidence& inc, const Eigen::VectorXd& q, std::vector<char> moved,
+                     const std::vector<char>& touched, Eigen::VectorXd& g) {
+    grow_region(W, inc, moved, 1);
+    for (size_t i = 0; i < moved.size(); ++i) moved[i] = moved[i] || touched[i];
+    gradient_rows(W, inc, q, moved, g);
 }
 
 }  // namespace fibernet

@@ -38,6 +38,21 @@ void grow_region(const WetEnergy& W, const ElementIncidence& inc, std::vector<ch
 // but held ones); each sorted. Fixed nodes never move and join nothing.
 std::vector<std::vector<int>> region_parts(const WetEnergy& W, const ElementIncidence& inc, const std::vector<char>& in);
 
+// Recomputes g's entries at the free coordinates of the flagged nodes as W's gradient at q: each from every element
+// at its node, summed in the order WetEnergy::gradient sums them (segments, hinges, bridges, each by index), so they
+// are W.gradient(q)'s bit for bit. Where the other entries are those of an earlier gradient whose elements at their
+// nodes were the same (relax_wet after a local round: only the region's nodes moved, a few bridges changed), g is
+// W.gradient(q) bit for bit at the cost of the flagged nodes' elements, not of the network's.
+void gradient_rows(const WetEnergy& W, const ElementIncidence& inc, const Eigen::VectorXd& q,
+                   const std::vector<char>& nodes, Eigen::VectorXd& g);
+
+// Brings g, the gradient of an earlier energy W0 at an earlier state q0, to W's gradient at q, bit for bit, where q
+// differs from q0 only at the `moved` nodes and W's elements from W0's only by bridges whose nodes are all `touched`
+// (bridges added, removed, moved or locked), the others in the same order: the rows that can differ are those of the
+// nodes of the elements at moved nodes and the touched nodes (recomputed by gradient_rows). inc is W's incidence.
+void update_gradient(const WetEnergy& W, const ElementIncidence& inc, const Eigen::VectorXd& q, std::vector<char> moved,
+                     const std::vector<char>& touched, Eigen::VectorXd& g);
+
 // Every node's displacement and position at a state q (NetworkEnergy::displacements, positions), computed once and
 // shared by the parts of one region: a part's evaluations rewrite its own nodes' entries only, which no other part's
 // elements read, so parts solved one after another need no copy each (at 1e4 fibers a copy costs as much as
@@ -60,7 +75,7 @@ public:
     double hessian(const Eigen::VectorXd& qa, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool psd) override {
         return eval(qa, &g, &H, psd);
     }
-    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override;
 
     // The region's coordinates of a full state, and back into one.
     Eigen::VectorXd restrict(const Eigen::VectorXd& q) const;
@@ -76,8 +91,10 @@ private:
     std::vector<int> segs_, hinges_, bridges_;  // elements with a node in the region
     // Per element: region index of each local coordinate (-1: held), and the Hessian value slot of each local pair
     // (a, b) with row <= column (-1 otherwise); segment 4 / 16, hinge 6 / 36, bridge 16 / 256.
-    std::vector<int> seg_idx_, hinge_idx_, bridge_idx_, seg_slot_, hinge_slot_, bridge_slot_;
-    Eigen::SparseMatrix<double> pattern_;
+    std::vector<int> seg_idx_, hinge_idx_, bridge_idx_;
+    mutable std::vector<int> seg_slot_, hinge_slot_, bridge_slot_;  // built with the pattern, on first use
+    mutable Eigen::SparseMatrix<double> pattern_;
+    mutable bool pattern_built_ = false;
 };
 
 }  // namespace fibernet
