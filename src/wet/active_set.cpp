@@ -246,20 +246,34 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
             if (nodes[a] >= 0 && (*moved)[nodes[a]]) return true;
         return false;
     };
+    // A bridge's element nodes (those of resolve(m, b).node, at a fraction of its cost: it is asked of every bridge).
+    auto element_nodes = [&](const Bridge& b, int* n) {
+        for (int s = 0; s < 2; ++s) {
+            const std::vector<int>& nodes = m.chains[s == 0 ? b.f1 : b.f2].nodes;
+            const int k = s == 0 ? b.k1 : b.k2, nseg = static_cast<int>(nodes.size()) - 1;
+            if (k < 0 || k >= nseg) throw std::logic_error("bridge home segment out of range");
+            n[4 * s] = k > 0 ? nodes[k - 1] : -1, n[4 * s + 1] = nodes[k], n[4 * s + 2] = nodes[k + 1];
+            n[4 * s + 3] = k + 1 < nseg ? nodes[k + 2] : -1;
+        }
+    };
+    std::vector<char> was_moved;  // per kept bridge: did it move in this update
+    was_moved.reserve(bridges.size());
+    int nodes8[8];
     for (Bridge b : bridges) {
-        if (is_frozen(b.f1, b.f2) || (moved && !any_moved(resolve(m, b).node, 8))) {
+        if (is_frozen(b.f1, b.f2) || (moved && (element_nodes(b, nodes8), !any_moved(nodes8, 8)))) {
             // kept as it is: frozen (relax_wet, after cycling), or none of its nodes moved since the last update
-            kept.push_back(b);
+            kept.push_back(b), was_moved.push_back(0);
             continue;
         }
         bool alive = true;
         if (b.locked) {
             const Contact c = pair_contact(b);
             alive = c.sin_angle <= std::min(1.0, 2 * sin_c) && c.distance <= 2 * rc && c.overlap > 0;
-            if (alive) kept.push_back(b);
+            if (alive) kept.push_back(b), was_moved.push_back(0);
             else ++ev.ruptures;
             continue;
         }
+        const int moves_before = ev.moves;
         const int limit = 4 + 2 * static_cast<int>(m.chains[b.f1].segments.size() + m.chains[b.f2].segments.size());
         CrossingPosition cp;
         for (int it = 0; it < limit && alive; ++it) {
@@ -304,12 +318,23 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
             ++ev.ruptures;
             continue;
         }
-        kept.push_back(b);
+        kept.push_back(b), was_moved.push_back(ev.moves != moves_before);
     }
     // Two bridges on one pair: keep the first. Found by sorting (key, position) pairs: a set of 4e4 keys (1e4 fibers)
-    // cost more in allocations every round.
-    std::vector<std::pair<Key, int>> order(kept.size());
-    for (size_t k = 0; k < kept.size(); ++k) order[k] = {key(kept[k]), static_cast<int>(k)};
+    // cost more in allocations every round. After a local round (moved given) the set it starts from has no two
+    // (relax_wet's first round is global, and every update leaves none), so only keys of bridges that moved can
+    // repeat: only the bridges with such a key are sorted.
+    std::vector<Key> moved_keys;
+    if (moved)
+        for (size_t k = 0; k < kept.size(); ++k)
+            if (was_moved[k]) moved_keys.push_back(key(kept[k]));
+    std::sort(moved_keys.begin(), moved_keys.end());
+    std::vector<std::pair<Key, int>> order;
+    order.reserve(moved ? 2 * moved_keys.size() : kept.size());
+    for (size_t k = 0; k < kept.size(); ++k) {
+        const Key kk = key(kept[k]);
+        if (!moved || std::binary_search(moved_keys.begin(), moved_keys.end(), kk)) order.push_back({kk, static_cast<int>(k)});
+    }
     std::sort(order.begin(), order.end());
     std::vector<char> duplicate(kept.size(), 0);
     for (size_t k = 1; k < order.size(); ++k)
