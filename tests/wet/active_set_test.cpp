@@ -124,6 +124,39 @@ TEST_CASE("active set: a bridge moves only a margin past a node (hysteresis agai
     CHECK(home_after(0.5 - 0.01) == 2);
 }
 
+TEST_CASE("active set: a bridge moved onto a bridged pair merges, after a global or a local round", "[wet][events]") {
+    // The kinked crossing above with a second bridge already on the next pair (segment 3 of fiber 1): the first one
+    // moving there makes two on one pair, and the first in the list is kept. After a local round (moved nodes given)
+    // only the keys of moved bridges are compared; both ways must agree.
+    const KinkedCrossing k;
+    const Model& m = k.m;
+    NetworkEnergy e(m);
+    const Eigen::VectorXd q = e.dofs(k.pos);
+    std::vector<Bridge> start = wet_crossings(k.net, m, e.positions(q, I2), m.box.B0(), {});
+    REQUIRE(start.size() == 1);
+    REQUIRE(start[0].k1 == 2);
+    REQUIRE(start[0].crossing >= 0);
+    Bridge next = start[0];
+    next.k1 = 3, next.crossing = -1;
+    start.push_back(next);
+    ActiveSetOptions opt;
+    opt.form_new = false;
+    const std::vector<char> all(m.num_nodes(), 1);
+    for (const std::vector<char>* moved_nodes : {static_cast<const std::vector<char>*>(nullptr), &all}) {
+        std::vector<Bridge> b = start;
+        WetEvents ev = update_bridges(e, moved(e, q, 1, 0.5 + 0.01, 0), I2, b, opt, nullptr, false, moved_nodes);
+        CHECK(ev.moves == 0);  // within the margin: both stay
+        CHECK(ev.merged == 0);
+        CHECK(b.size() == 2);
+        ev = update_bridges(e, moved(e, q, 1, 0.5 + 0.04, 0), I2, b, opt, nullptr, false, moved_nodes);
+        CHECK(ev.moves == 1);
+        CHECK(ev.merged == 1);
+        REQUIRE(b.size() == 1);
+        CHECK(b[0].k1 == 3);
+        CHECK(b[0].crossing == start[0].crossing);  // the first one, moved
+    }
+}
+
 TEST_CASE("active set: sliding along a straight fiber keeps the capillary energy", "[wet][events]") {
     // Fiber 2 translated along its own axis: its crossing slides along fiber 2 across nodes (equal segments).
     const Network net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.55, 1.5, 70, 1, 0.45}}, 3);
