@@ -246,21 +246,11 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
             if (nodes[a] >= 0 && (*moved)[nodes[a]]) return true;
         return false;
     };
-    // A bridge's element nodes (those of resolve(m, b).node, at a fraction of its cost: it is asked of every bridge).
-    auto element_nodes = [&](const Bridge& b, int* n) {
-        for (int s = 0; s < 2; ++s) {
-            const std::vector<int>& nodes = m.chains[s == 0 ? b.f1 : b.f2].nodes;
-            const int k = s == 0 ? b.k1 : b.k2, nseg = static_cast<int>(nodes.size()) - 1;
-            if (k < 0 || k >= nseg) throw std::logic_error("bridge home segment out of range");
-            n[4 * s] = k > 0 ? nodes[k - 1] : -1, n[4 * s + 1] = nodes[k], n[4 * s + 2] = nodes[k + 1];
-            n[4 * s + 3] = k + 1 < nseg ? nodes[k + 2] : -1;
-        }
-    };
     std::vector<char> was_moved;  // per kept bridge: did it move in this update
     was_moved.reserve(bridges.size());
     int nodes8[8];
     for (Bridge b : bridges) {
-        if (is_frozen(b.f1, b.f2) || (moved && (element_nodes(b, nodes8), !any_moved(nodes8, 8)))) {
+        if (is_frozen(b.f1, b.f2) || (moved && (bridge_nodes(m, b, nodes8), !any_moved(nodes8, 8)))) {
             // kept as it is: frozen (relax_wet, after cycling), or none of its nodes moved since the last update
             kept.push_back(b), was_moved.push_back(0);
             continue;
@@ -576,19 +566,21 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         // accepted one, so stable still means an equilibrium of every coordinate.
         bool equilibrium = false;
         double gmax = 0;
-        std::vector<std::array<int, 7>> changed;  // the bridges this round changed (both sets' entries)
-        std::set_symmetric_difference(history.back().begin(), history.back().end(), sig.begin(), sig.end(),
-                                      std::back_inserter(changed));
-        auto changed_nodes = [&](std::vector<char>& flags) {
-            for (const auto& k : changed) {
-                Bridge b;
-                b.f1 = k[0], b.f2 = k[1], b.k1 = k[2], b.k2 = k[3], b.image = Eigen::Vector2i(k[4], k[5]);
-                for (int node : resolve(dry.model(), b).node)
-                    if (node >= 0) flags[node] = 1;
-            }
-        };
         if (r.last.converged() || use_local) {
             const double tg = now();
+            std::vector<std::array<int, 7>> changed;  // the bridges this round changed (both sets' entries)
+            std::set_symmetric_difference(history.back().begin(), history.back().end(), sig.begin(), sig.end(),
+                                          std::back_inserter(changed));
+            auto changed_nodes = [&](std::vector<char>& flags) {
+                int nodes[8];
+                for (const auto& k : changed) {
+                    Bridge b;
+                    b.f1 = k[0], b.f2 = k[1], b.k1 = k[2], b.k2 = k[3];
+                    bridge_nodes(dry.model(), b, nodes);
+                    for (int node : nodes)
+                        if (node >= 0) flags[node] = 1;
+                }
+            };
             next = std::make_unique<WetEnergy>(dry, F, bridges, params);
             WetEnergy& Wn = *next;
             if (local && g_valid) {

@@ -9,33 +9,41 @@
 
 namespace fibernet {
 
+void bridge_nodes(const Model& m, const Bridge& b, int node[8]) {
+    for (int s = 0; s < 2; ++s) {
+        const std::vector<int>& nodes = m.chains[s == 0 ? b.f1 : b.f2].nodes;
+        const int k = s == 0 ? b.k1 : b.k2, nseg = static_cast<int>(nodes.size()) - 1;
+        if (k < 0 || k >= nseg) throw std::logic_error("bridge home segment out of range");
+        int* nd = node + 4 * s;
+        nd[0] = k > 0 ? nodes[k - 1] : -1, nd[1] = nodes[k], nd[2] = nodes[k + 1];
+        nd[3] = k + 1 < nseg ? nodes[k + 2] : -1;
+    }
+}
+
 BridgeElement resolve(const Model& m, const Bridge& b) {
     BridgeElement e;
     e.locked = b.locked;
+    bridge_nodes(m, b, e.node);
     for (int s = 0; s < 2; ++s) {
         const FiberChain& ch = m.chains[s == 0 ? b.f1 : b.f2];
         const int k = s == 0 ? b.k1 : b.k2;
         const int nseg = static_cast<int>(ch.segments.size());
-        if (k < 0 || k >= nseg) throw std::logic_error("bridge home segment out of range");
         const Eigen::Vector2i base = s == 0 ? Eigen::Vector2i(0, 0) : b.image;
         const Segment& h = m.segments[ch.segments[k]];
-        int* nd = e.node + 4 * s;
         Eigen::Vector2i* sh = e.shift + 4 * s;
         double* l0 = e.l0 + 3 * s;
-        nd[1] = ch.nodes[k], sh[1] = base;
-        nd[2] = ch.nodes[k + 1], sh[2] = base + h.shift;
-        l0[1] = h.l0;
+        sh[1] = base, sh[2] = base + h.shift, l0[1] = h.l0;
         if (k > 0) {
             const Segment& p = m.segments[ch.segments[k - 1]];
-            nd[0] = ch.nodes[k - 1], sh[0] = base - p.shift, l0[0] = p.l0;
+            sh[0] = base - p.shift, l0[0] = p.l0;
         } else {
-            nd[0] = -1, sh[0] = base, l0[0] = 0;
+            sh[0] = base, l0[0] = 0;
         }
         if (k + 1 < nseg) {
             const Segment& n = m.segments[ch.segments[k + 1]];
-            nd[3] = ch.nodes[k + 2], sh[3] = sh[2] + n.shift, l0[2] = n.l0;
+            sh[3] = sh[2] + n.shift, l0[2] = n.l0;
         } else {
-            nd[3] = -1, sh[3] = sh[2], l0[2] = 0;
+            sh[3] = sh[2], l0[2] = 0;
         }
     }
     return e;

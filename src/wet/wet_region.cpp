@@ -28,6 +28,16 @@ void build_rows(int nn, int ne, NodesOf nodes_of, std::vector<int>& start, std::
             if (n[a] >= 0 && std::find(n, n + a, n[a]) == n + a) list[fill[n[a]]++] = e;
     }
 }
+
+// The elements of one kind (compressed rows start/list) at the given nodes, each once, in index order: the order in
+// which the whole energy sums them.
+std::vector<int> elements_at(const std::vector<int>& start, const std::vector<int>& list, const std::vector<int>& nodes) {
+    std::vector<int> out;
+    for (int v : nodes) out.insert(out.end(), list.begin() + start[v], list.begin() + start[v + 1]);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
 }  // namespace
 
 ElementIncidence element_incidence(const WetEnergy& W) {
@@ -156,15 +166,9 @@ WetRegion::WetRegion(const WetEnergy& W, RegionState& state, const std::vector<i
             out.push_back(l < 0 ? -1 : compact[l]);
         }
     };
-    // Elements at the region's nodes, each once.
-    auto gather = [&](const std::vector<int>& start, const std::vector<int>& list, std::vector<int>& out) {
-        for (int v : order) out.insert(out.end(), list.begin() + start[v], list.begin() + start[v + 1]);
-        std::sort(out.begin(), out.end());
-        out.erase(std::unique(out.begin(), out.end()), out.end());
-    };
-    gather(inc.seg_start, inc.seg, segs_);
-    gather(inc.hinge_start, inc.hinge, hinges_);
-    gather(inc.bridge_start, inc.bridge, bridges_);
+    segs_ = elements_at(inc.seg_start, inc.seg, order);
+    hinges_ = elements_at(inc.hinge_start, inc.hinge, order);
+    bridges_ = elements_at(inc.bridge_start, inc.bridge, order);
     for (int e : segs_) {
         const int n[2] = {m.segments[e].i, m.segments[e].j};
         index(n, 2, seg_idx_);
@@ -256,23 +260,18 @@ void gradient_rows(const WetEnergy& W, const ElementIncidence& inc, const Eigen:
     const NetworkEnergy& dry = W.dry();
     const Model& m = dry.model();
     const Eigen::Matrix2d& F = W.F();
-    // The elements at the flagged nodes, each once, in index order (as WetRegion gathers them, without its index
-    // tables: here each element's entries go straight to g).
-    std::vector<int> segs, hinges, bridges;
-    auto gather = [&](int v, const std::vector<int>& start, const std::vector<int>& list, std::vector<int>& out) {
-        out.insert(out.end(), list.begin() + start[v], list.begin() + start[v + 1]);
-    };
+    // The elements at the flagged nodes (as WetRegion gathers them, without its index tables: here each element's
+    // entries go straight to g).
+    std::vector<int> flagged;
     for (int v = 0; v < static_cast<int>(nodes.size()); ++v) {
         if (!nodes[v]) continue;
+        flagged.push_back(v);
         for (int c = 0; c < 2; ++c)
             if (dry.dof(v, c) >= 0) g[dry.dof(v, c)] = 0;
-        gather(v, inc.seg_start, inc.seg, segs), gather(v, inc.hinge_start, inc.hinge, hinges);
-        gather(v, inc.bridge_start, inc.bridge, bridges);
     }
-    for (auto* list : {&segs, &hinges, &bridges}) {
-        std::sort(list->begin(), list->end());
-        list->erase(std::unique(list->begin(), list->end()), list->end());
-    }
+    const std::vector<int> segs = elements_at(inc.seg_start, inc.seg, flagged);
+    const std::vector<int> hinges = elements_at(inc.hinge_start, inc.hinge, flagged);
+    const std::vector<int> bridges = elements_at(inc.bridge_start, inc.bridge, flagged);
     // An element's local coordinate a adds to g where its node is flagged, in the order a = 0, 1, ... (as
     // NetworkEnergy::evaluate and WetEnergy::eval add them).
     auto add = [&](const int* n, int M, const double* ge) {

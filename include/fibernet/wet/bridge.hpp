@@ -60,6 +60,8 @@ struct BridgeElement {
     bool locked = false;
 };
 BridgeElement resolve(const Model& m, const Bridge& b);
+// resolve(m, b).node alone, at a fraction of its cost (the active-set loop asks it of every bridge each round).
+void bridge_nodes(const Model& m, const Bridge& b, int node[8]);
 
 // Local coordinates of the element (absent nodes: zero) at node positions x and box matrix B.
 Vector16d element_coordinates(const BridgeElement& e, const Eigen::VectorXd& x, const Eigen::Matrix2d& B);
