@@ -95,6 +95,7 @@ nlohmann::json free_box_json(const FreeBoxResult& f, const FreeBoxOptions& o) {
                {{"moves", f.events.moves}, {"ruptures", f.events.ruptures}, {"formed", f.events.formed},
                 {"merged", f.events.merged}, {"locked", f.events.locked}}},
               {"pores", pore_json(f.pores)},
+              {"shear_modulus", num(f.shear_modulus)},
               {"bundles",
                {{"bundled_fibers", f.bundles.bundled_fibers}, {"count", f.bundles.sizes.size()},
                 {"largest", f.bundles.sizes.empty() ? 1 : f.bundles.sizes.front()}, {"size_histogram", bh}}},
@@ -197,8 +198,8 @@ void register_wet(CLI::App& app) {
         nlohmann::json runs = nlohmann::json::array();
         std::ostringstream sweep, pore_csv;
         sweep << "beta,status,bridges,moves,ruptures,formed,merged,rounds,E_stretch,E_bend,E_capillary,pores,mean_pore_area,"
-                 "mean_pore_diameter,bundled_fibers,largest_bundle,G_dry,G_wet";
-        if (opt.free_box.enabled) sweep << ",free_box,s,areal_shrinkage,free_box_residual,free_box_iterations";
+                 "mean_pore_diameter,bundled_fibers,largest_bundle,G_dry,G_wet,G_dry_fd,G_wet_fd";
+        if (opt.free_box.enabled) sweep << ",free_box,s,areal_shrinkage,free_box_residual,free_box_iterations,G_free_box";
         sweep << "\n";
         pore_csv << "state,beta,area,diameter\n";
         sweep.precision(10), pore_csv.precision(10);
@@ -244,10 +245,11 @@ void register_wet(CLI::App& app) {
                   << r.wet.energy.bend << "," << r.wet.energy.capillary << "," << pw.size() << ","
                   << (pw.empty() ? 0 : sum / pw.size()) << "," << (pw.empty() ? 0 : dsum / pw.size()) << ","
                   << r.bundles.bundled_fibers << "," << largest << "," << dry_state.shear_modulus << ","
-                  << r.wet.shear_modulus;
+                  << r.wet.shear_modulus << "," << dry_state.shear_modulus_fd << "," << r.wet.shear_modulus_fd;
             if (opt.free_box.enabled)
                 sweep << "," << (r.free_box.converged ? "converged" : "not_converged") << "," << r.free_box.s << ","
-                      << r.free_box.areal_shrinkage << "," << r.free_box.residual << "," << r.free_box.iterations;
+                      << r.free_box.areal_shrinkage << "," << r.free_box.residual << "," << r.free_box.iterations << ","
+                      << r.free_box.shear_modulus;
             sweep << "\n";
             if (!dry_written) {
                 for (const auto& p : r.dry.pores.pores) pore_csv << "dry,0," << p.area << "," << p.diameter << "\n";
@@ -308,6 +310,9 @@ void register_wet(CLI::App& app) {
                    {"largest", largest}, {"size_histogram", hist}, {"aligned_bridges", r.bundles.aligned_bridges}}},
                  {"pores", {{"dry", pore_json(r.dry.pores)}, {"wet", pore_json(r.wet.pores)}}},
                  {"shear_modulus", {{"dry", num(dry_state.shear_modulus)}, {"wet", num(r.wet.shear_modulus)}}},
+                 {"shear_modulus_second_difference",
+                  {{"dry", num(dry_state.shear_modulus_fd)}, {"wet", num(r.wet.shear_modulus_fd)},
+                   {"strain", opt.modulus_strain}}},
                  {"solver", solve_json(r.active.last, s.solver.tol)},
                  {"free_box", opt.free_box.enabled ? free_box_json(r.free_box, opt.free_box) : nlohmann::json()},
                  {"solver_iterations", r.active.solver_iterations},

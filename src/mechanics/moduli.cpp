@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <algorithm>
+#include <stdexcept>
 
 #include <Eigen/LU>
 #include <limits>
@@ -87,6 +88,51 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
         return out;
     }
 
+    // The relaxed part, in comoving coordinates (relaxed_moduli).
+    const Eigen::VectorXd x = e.positions(q, F);  // absolute positions: the affine velocity is dF F^-1 x
+    std::vector<StrainTerms> terms(modes.size());
+    for (size_t m = 0; m < modes.size(); ++m)
+        terms[m] = {out[m].E_tt, std::move(b[m]), affine_velocity(e, x, modes[m].dF * F.inverse())};
+    ModuliInfo core;
+    std::vector<Modulus> relaxed = relaxed_moduli(H, terms, modes, opt, &core, shared_llt);
+    for (size_t m = 0; m < modes.size(); ++m) {
+        relaxed[m].name = out[m].name;
+        relaxed[m].affine = at_affine ? modes[m].scale * relaxed[m].E_tt : out[m].affine;  // comoving E_tt: affine
+    }
+    core.seconds_assembly += inf.seconds_assembly;
+    core.seconds_affine = inf.seconds_affine;
+    inf = core;
+    inf.seconds_total = since(t_start);
+    return relaxed;
+}
+
+Eigen::VectorXd affine_velocity(const NetworkEnergy& e, const Eigen::VectorXd& x, const Eigen::Matrix2d& V) {
+    Eigen::VectorXd v(e.num_dofs());
+    for (int i = 0; i < e.model().num_nodes(); ++i)
+        if (e.dof(i, 0) >= 0) v.segment<2>(e.dof(i, 0)) = V * x.segment<2>(2 * i);
+    return v;
+}
+
+std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const std::vector<StrainTerms>& terms,
+                                    const std::vector<StrainMode>& modes, const ModuliOptions& opt, ModuliInfo* info,
+                                    CholmodLLT* shared_llt) {
+    const auto t_start = Clock::now();
+    ModuliInfo local;
+    ModuliInfo& inf = info ? *info : local;
+    inf = ModuliInfo{};
+    const int n = static_cast<int>(H.rows());
+    if (terms.size() != modes.size()) throw std::logic_error("relaxed_moduli: one StrainTerms per mode");
+    std::vector<Modulus> out(modes.size());
+    for (size_t m = 0; m < modes.size(); ++m) {
+        out[m].name = modes[m].name;
+        out[m].E_tt = terms[m].E_tt;
+        if (terms[m].b.size() != n || terms[m].v.size() != n) throw std::logic_error("relaxed_moduli: wrong sizes");
+    }
+    if (n == 0) {  // nothing can relax: the modulus is the fixed-coordinate term
+        for (size_t m = 0; m < modes.size(); ++m) out[m].value = modes[m].scale * out[m].E_tt, out[m].ok = true;
+        inf.seconds_total = since(t_start);
+        return out;
+    }
     // Shift scale: first the median |diagonal|; the mean, which a few segments of 1e-5 (stiffness 1/l) inflate by
     // 1e2..1e5 at L = 80, leaves many soft modes below the shift for the CG (measured at L = 80: 23 and 15 steps
     // against 3 and 12, and a K whose CG stopped 2e-3 short of the median-shift value with a bound of 6e-5). With the
@@ -98,10 +144,8 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
     std::nth_element(diag.begin(), diag.begin() + n / 2, diag.end());
     const double median_scale = std::max(diag[n / 2], std::numeric_limits<double>::min());
     // The right-hand sides in comoving coordinates, the same for both shift scales below.
-    t0 = Clock::now();
+    auto t0 = Clock::now();
     const auto Hs = H.selfadjointView<Eigen::Upper>();
-    const Eigen::Matrix2d Finv = F.inverse();
-    const Eigen::VectorXd x = e.positions(q, F);  // absolute positions: the affine velocity is dF F^-1 x
     const int M = static_cast<int>(modes.size());
     Eigen::MatrixXd B(n, M), V(n, M);
     for (int m = 0; m < M; ++m) {
@@ -109,13 +153,10 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
         //   E_tt - b.H^+ b = (E_tt + 2 v.b + v.H v) - (b + H v).H^+ (b + H v)     (b in range(H)),
         // whose two terms are the affine and non-affine parts: O(G A) instead of O(L^2 k) with absolute
         // coordinates, where box-crossing segments make E_tt ~ 1e8 and the cancellation costs 6 digits.
-        const Eigen::Matrix2d Vm = modes[m].dF * Finv;
-        Eigen::VectorXd v(n);
-        for (int i = 0; i < e.model().num_nodes(); ++i)
-            if (e.dof(i, 0) >= 0) v.segment<2>(e.dof(i, 0)) = Vm * x.segment<2>(2 * i);
+        const Eigen::VectorXd& v = terms[m].v;
         const Eigen::VectorXd Hv = Hs * v;
-        out[m].E_tt += 2 * v.dot(b[m]) + v.dot(Hv);
-        B.col(m) = b[m] + Hv;
+        out[m].E_tt += 2 * v.dot(terms[m].b) + v.dot(Hv);
+        B.col(m) = terms[m].b + Hv;
         V.col(m) = v;
     }
     const double seconds_setup = since(t0);
@@ -223,7 +264,6 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
             // Accepted when converged, or stopped by round-off with the tail below 1e-7 of the cancellation scale
             // (the seed scheme's 1e-4 segments at L = 20 end there; the error is reported).
             Mo.ok = std::isfinite(Mo.value) && !broke[m] && (conv[m] || tail <= 1e-7 * scale_ref[m]);
-            if (at_affine) Mo.affine = modes[m].scale * Mo.E_tt;
             if (!Mo.ok)
                 inf.message = broke[m] ? "H is not positive semidefinite at this state (a saddle): no modulus for " + Mo.name
                                        : "conjugate gradients for H^+ E_xt did not converge for " + Mo.name;

@@ -9,11 +9,26 @@
 #include <limits>
 #include <sstream>
 
+#include "fibernet/wet/wet_moduli.hpp"
+
 namespace fibernet {
 
 namespace {
 double now() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+namespace {
+// WetState's two shear moduli at (q, F) with the bridge set frozen: the second difference first (its solves leave
+// the solver as before the exact modulus existed, so what follows, e.g. the free box, takes the same path).
+void shear_moduli(WetState& s, const NetworkEnergy& dry, const Eigen::Matrix2d& F, const std::vector<Bridge>& bridges,
+                  const WetParams& params, Solver& solver, double h) {
+    s.shear_modulus_fd = relaxed_shear_modulus(dry, F, s.q, bridges, params, solver, h);
+    WetEnergy W(dry, F, bridges, params);
+    const double A = std::abs((F * dry.model().box.B0()).determinant());
+    const Modulus G = wet_linear_moduli(W, s.q, {shear_mode(F, A)}).front();
+    s.shear_modulus = G.ok ? G.value : std::numeric_limits<double>::quiet_NaN();
 }
 }  // namespace
 
@@ -54,10 +69,10 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
         t0 = now();
         run.dry.pores = pores(m, dry.positions(run.dry.q, F), B);
         run.seconds_pores += now() - t0;
-        run.dry.shear_modulus = std::numeric_limits<double>::quiet_NaN();
+        run.dry.shear_modulus = run.dry.shear_modulus_fd = std::numeric_limits<double>::quiet_NaN();
         if (opt.moduli && run.dry.converged) {
             t0 = now();
-            run.dry.shear_modulus = relaxed_shear_modulus(dry, F, run.dry.q, {}, none, *solver, opt.modulus_strain);
+            shear_moduli(run.dry, dry, F, {}, none, *solver, opt.modulus_strain);
             run.seconds_moduli += now() - t0;
         }
     }
@@ -83,11 +98,10 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     run.wet.pores = pores(m, x, B);
     run.bundles = bundles(m, x, B, run.active.bridges, opt.bundle_angle_deg);
     run.seconds_pores += now() - t0;
-    run.wet.shear_modulus = std::numeric_limits<double>::quiet_NaN();
+    run.wet.shear_modulus = run.wet.shear_modulus_fd = std::numeric_limits<double>::quiet_NaN();
     if (opt.moduli && run.wet.converged) {
         t0 = now();
-        run.wet.shear_modulus =
-            relaxed_shear_modulus(dry, F, run.wet.q, run.active.bridges, opt.params, *solver, opt.modulus_strain);
+        shear_moduli(run.wet, dry, F, run.active.bridges, opt.params, *solver, opt.modulus_strain);
         run.seconds_moduli += now() - t0;
     }
     if (opt.free_box.enabled) {
@@ -98,6 +112,15 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
             const Eigen::VectorXd xf = dry.positions(run.free_box.q, run.free_box.F);
             run.free_box.pores = pores(m, xf, Bf);
             run.free_box.bundles = bundles(m, xf, Bf, run.free_box.bridges, opt.bundle_angle_deg);
+            run.free_box.shear_modulus = std::numeric_limits<double>::quiet_NaN();
+            if (opt.moduli) {
+                t0 = now();
+                WetEnergy W(dry, run.free_box.F, run.free_box.bridges, opt.params);
+                const double A = std::abs(Bf.determinant());
+                const Modulus G = wet_linear_moduli(W, run.free_box.q, {shear_mode(run.free_box.F, A)}).front();
+                if (G.ok) run.free_box.shear_modulus = G.value;
+                run.seconds_moduli += now() - t0;
+            }
         } else {
             run.free_box.F0 = run.free_box.F = F;
             run.free_box.message = "not attempted: the wet relaxation at the fixed box is not a stable equilibrium";

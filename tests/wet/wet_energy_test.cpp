@@ -58,6 +58,42 @@ void check_derivatives(const Model& m, const Eigen::Matrix2d& F, double amp, std
     CHECK(fdtest::rel_err(Hf, fdtest::fd_jacobian(grad, q, h)) < 1e-6);
     CHECK(fdtest::rel_err(g - gd, fdtest::fd_gradient(capval, q, h), 1e-3) < 1e-6);
     CHECK(fdtest::rel_err(Hcap, fdtest::fd_jacobian(capgrad, q, h), 1e-3) < 1e-5);
+
+    // Strain derivatives at fixed q along F + t dF (WetEnergy::strain_derivatives, for the wet linear moduli): dE/dt
+    // and d2E/dq dt against central differences in t of the energy and its gradient, d2E/dt2 against those of dE/dt;
+    // the whole energy and the bridges' part alone. Simple shear of the current box and a general direction.
+    Eigen::Matrix2d shear = Eigen::Matrix2d::Zero(), general;
+    shear(0, 1) = 1;
+    general << 0.3, -0.7, 0.4, 0.2;
+    for (const Eigen::Matrix2d& dF : {Eigen::Matrix2d(shear * F), general}) {
+        auto terms = [&](const WetParams& pp, double t) {
+            EnergyEval ev;
+            WetEnergy(dry, F + t * dF, bridges, pp).strain_derivatives(q, dF, ev);
+            return ev;
+        };
+        auto energy = [&](const WetParams& pp, double t) { return WetEnergy(dry, F + t * dF, bridges, pp).value(q); };
+        auto gradient = [&](const WetParams& pp, double t) {
+            Eigen::VectorXd r;
+            WetEnergy(dry, F + t * dF, bridges, pp).gradient(q, r);
+            return r;
+        };
+        const EnergyEval w = terms(p, 0), d = terms(p0, 0);
+        const double ht = 1e-6;
+        const double Et_fd = (energy(p, ht) - energy(p, -ht)) / (2 * ht), Et0_fd = (energy(p0, ht) - energy(p0, -ht)) / (2 * ht);
+        const Eigen::VectorXd b_fd = (gradient(p, ht) - gradient(p, -ht)) / (2 * ht);
+        const Eigen::VectorXd b0_fd = (gradient(p0, ht) - gradient(p0, -ht)) / (2 * ht);
+        const double Ett_fd = (terms(p, ht).dE_dt - terms(p, -ht).dE_dt) / (2 * ht);
+        const double Ett0_fd = (terms(p0, ht).dE_dt - terms(p0, -ht).dE_dt) / (2 * ht);
+        INFO("dF = " << dF.format(Eigen::IOFormat(4)) << ": dE/dt " << w.dE_dt << " (fd " << Et_fd << "), bridges' "
+                     << w.dE_dt - d.dE_dt << " (fd " << Et_fd - Et0_fd << "); d2E/dt2 " << w.d2E_dt2 << " (fd " << Ett_fd
+                     << "), bridges' " << w.d2E_dt2 - d.d2E_dt2 << " (fd " << Ett_fd - Ett0_fd << ")");
+        CHECK(std::abs((w.dE_dt - d.dE_dt) - (Et_fd - Et0_fd)) <= 1e-6 * (1e-3 + std::abs(Et_fd - Et0_fd)));
+        CHECK(std::abs(w.dE_dt - Et_fd) <= 1e-6 * (1e-3 + std::abs(Et_fd)));
+        CHECK(std::abs((w.d2E_dt2 - d.d2E_dt2) - (Ett_fd - Ett0_fd)) <= 1e-5 * (1e-3 + std::abs(Ett_fd - Ett0_fd)));
+        CHECK(std::abs(w.d2E_dt2 - Ett_fd) <= 1e-5 * (1e-3 + std::abs(Ett_fd)));
+        CHECK(fdtest::rel_err(w.d2E_dqdt - d.d2E_dqdt, b_fd - b0_fd, 1e-3) < 1e-5);
+        CHECK(fdtest::rel_err(w.d2E_dqdt, b_fd) < 1e-6);
+    }
 }
 
 CapillaryLaw table() {
@@ -103,6 +139,15 @@ TEST_CASE("wet energy: gradient and Hessian match finite differences", "[wet][gr
         const Network net = mikado(2.5, 4, 0.5, 7);
         const Model m = model_of(net, 4);
         check_derivatives(m, Eigen::Matrix2d::Identity(), 0.002, 71, def, 5);
+    }
+    SECTION("fixed nodes (clamps) in a sheared box") {
+        // A fixed node sits at F x_ref: a bridge on it moves with F (its strain derivatives' fixed-node term).
+        Model m = model_of(mikado(2.5, 4, 0.5, 7), 4);
+        m.fixed.assign(m.num_nodes(), 0);
+        for (int i = 0; i < m.num_nodes(); i += 5) m.fixed[i] = 1;
+        Eigen::Matrix2d F;
+        F << 1.05, 0.2, -0.1, 0.95;
+        check_derivatives(m, F, 0.002, 81, def, 5);
     }
 }
 

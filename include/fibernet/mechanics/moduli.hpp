@@ -17,6 +17,7 @@
 //   path    : dF = strain_direction(kind) of the scene's path, (1/A) d2E/dt2.
 // The affine prediction of each is scale * d2E/dt2 along the affine path x(t) = F(t) x_ref (no relaxation).
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <string>
 #include <vector>
 
@@ -60,10 +61,26 @@ struct ModuliInfo {
     std::string message;
 };
 
+// The relaxed part on its own, for any energy that provides its Hessian H (upper triangle, at an equilibrium) and,
+// per mode, the fixed-coordinate strain derivatives: value = scale * (E_tt - b.H^+ b), computed in comoving
+// coordinates (v: the affine velocity dF F^-1 x of the free coordinates, affine_velocity) as above. linear_moduli
+// is this plus the dry energy's derivatives and the affine prediction; the wet energy's linear moduli use it with the
+// bridges' terms (wet/wet_moduli.hpp). Modulus::affine is left 0.
+struct StrainTerms {
+    double E_tt = 0;    // d2E/dt2 at fixed q
+    Eigen::VectorXd b;  // d2E/dq dt at fixed q
+    Eigen::VectorXd v;  // affine velocity of the free coordinates
+};
+class CholmodLLT;
+std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const std::vector<StrainTerms>& terms,
+                                    const std::vector<StrainMode>& modes, const ModuliOptions& opt = {},
+                                    ModuliInfo* info = nullptr, CholmodLLT* llt = nullptr);
+// V x_i for every free node i (x: all nodes' positions, 2 per node), in q's layout.
+Eigen::VectorXd affine_velocity(const NetworkEnergy& e, const Eigen::VectorXd& x, const Eigen::Matrix2d& V);
+
 // llt: an optional CHOLMOD wrapper already analyzed for e.hessian_pattern() (e.g. NewtonSolver::factorization()
 // after the equilibrium solve), so that the modulus costs one numeric factorization and no symbolic analysis.
 // Its numeric factor is overwritten.
-class CholmodLLT;
 std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
                                    const std::vector<StrainMode>& modes, const ModuliOptions& opt = {},
                                    ModuliInfo* info = nullptr, CholmodLLT* llt = nullptr);

@@ -4,6 +4,7 @@
 // and wet; optionally the free box: the box deformation at which the wet network carries no macroscopic stress
 // (drying shrinkage). Shared by the CLI and bench/bench_wet.cpp.
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -87,6 +88,7 @@ struct FreeBoxResult {
     WetEvents events;             // summed over the accepted relaxations
     PoreStats pores;
     BundleStats bundles;
+    double shear_modulus = std::numeric_limits<double>::quiet_NaN();  // linear, bridge set frozen (wet_moduli.hpp), at F
     double seconds = 0;
 };
 
@@ -97,7 +99,8 @@ struct WetRunOptions {
     std::string solver = "newton";
     SolverOptions solver_options;
     double bundle_angle_deg = 10;
-    bool moduli = true;          // linear shear modulus dry and wet (two extra relaxations each, see wet_run.cpp)
+    bool moduli = true;          // linear shear modulus dry and wet (one factorization each, and two relaxations each for
+                                 // the second difference at modulus_strain; see WetState)
     double modulus_strain = 1e-4;
     FreeBoxOptions free_box;
 };
@@ -106,7 +109,12 @@ struct WetState {
     Eigen::VectorXd q;
     WetSplit energy;
     PoreStats pores;
-    double shear_modulus = 0;    // NaN when not computed or a relaxation failed
+    // Linear shear modulus with the bridge set frozen (wet_moduli.hpp: exact, one factorization), and the central
+    // second difference of relaxed energies at gamma = +-modulus_strain (relaxed_shear_modulus), which departs from
+    // it when a capillary instability lies within that strain. NaN when not computed or when it failed (a saddle, a
+    // relaxation that did not converge).
+    double shear_modulus = 0;
+    double shear_modulus_fd = 0;
     bool converged = false;
 };
 
