@@ -118,6 +118,7 @@ void register_wet(CLI::App& app) {
         bool no_moduli = false, verbose = false, quiet = false, free_box = false;
         std::string free_box_shape;
         double free_box_tol = 0;
+        double modulus_strain = 0;
     };
     auto w = std::make_shared<WetFlags>();
     auto* o_beta = cmd->add_option("--beta", w->beta, "adhesion per unit bundle length, bending units (default 1)");
@@ -129,6 +130,9 @@ void register_wet(CLI::App& app) {
     cmd->add_option("-o,--out-dir", w->out,
                     "write summary.json, sweep.csv, pores.csv, network.svg, pores.svg here (created if missing)");
     cmd->add_flag("--no-moduli", w->no_moduli, "skip the dry and wet shear moduli");
+    auto* o_ms = cmd->add_option("--modulus-strain", w->modulus_strain,
+                                 "shear strain h of the moduli's second difference of relaxed energies at +-h, "
+                                 "reported beside the exact linear moduli (default 1e-4; docs/wet.md)");
     auto* o_fb = cmd->add_flag("--free-box", w->free_box,
                                "then find the zero-stress box of the wet network (drying shrinkage, docs/wet.md)");
     auto* o_fbs = cmd->add_option("--free-box-shape", w->free_box_shape,
@@ -172,6 +176,12 @@ void register_wet(CLI::App& app) {
         opt.active_set.local_hops = s.wet.local_hops;
         if (w->verbose && w->quiet) throw InputError("--verbose and --quiet contradict each other");
         opt.moduli = !w->no_moduli;
+        if (o_ms->count()) {
+            check_value(std::isfinite(w->modulus_strain) && w->modulus_strain > 0 && w->modulus_strain <= 0.1,
+                        w->modulus_strain, "--modulus-strain", "modulus strain", "must be in (0, 0.1]");
+            if (w->no_moduli) throw InputError("--modulus-strain given with --no-moduli");
+            opt.modulus_strain = w->modulus_strain;
+        }
         make_solver(opt.solver, opt.solver_options);  // an unknown solver is an InputError before any work
         if (!s.wet.free_box && (o_fbs->count() || o_fbt->count()))
             throw InputError(std::string(o_fbs->count() ? "--free-box-shape" : "--free-box-tol") +

@@ -28,6 +28,7 @@ TEST_CASE("cli wet: a small run writes its documented outputs", "[wet][cli]") {
     CHECK(j.find("\"local_rounds\": 0") != std::string::npos);  // beta = 0: one global solve
     CHECK(j.find("\"complete\": true") != std::string::npos);  // false in the copies written between betas
     CHECK(slurp(out + "/sweep.csv").rfind("beta,status,bridges", 0) == 0);
+    CHECK(slurp(out + "/sweep.csv").find("G_dry,G_wet,G_dry_fd,G_wet_fd") != std::string::npos);
     // Progress on stderr by default: a line per beta and per active-set round; none with --quiet.
     const std::string err = slurp(tmpdir() + "/stderr");
     CHECK(err.find("wet: beta = 0 (1 of 1)") != std::string::npos);
@@ -57,7 +58,10 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
                           Case{"--free-box --free-box-tol nan", "free_box_tol = nan"},
                           Case{"--free-box-tol 1e-3", "--free-box-tol given without --free-box"},
                           Case{"--free-box-shape full", "--free-box-shape given without --free-box"},
-                          Case{"-q -v", "--verbose and --quiet"}}) {
+                          Case{"-q -v", "--verbose and --quiet"},
+                          Case{"--modulus-strain -1e-4", "modulus strain = -0.0001"},
+                          Case{"--modulus-strain nan", "modulus strain = nan"},
+                          Case{"--modulus-strain 1e-4 --no-moduli", "--modulus-strain given with --no-moduli"}}) {
         INFO(c.args);
         CHECK(run("--L 2.5 --q 5 " + c.args + " -o " + out) == 2);
         CHECK(slurp(tmpdir() + "/stderr").find(c.needle) != std::string::npos);
