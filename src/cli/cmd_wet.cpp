@@ -320,6 +320,7 @@ void register_wet(CLI::App& app) {
                    {"largest", largest}, {"size_histogram", hist}, {"aligned_bridges", r.bundles.aligned_bridges}}},
                  {"pores", {{"dry", pore_json(r.dry.pores)}, {"wet", pore_json(r.wet.pores)}}},
                  {"shear_modulus", {{"dry", num(dry_state.shear_modulus)}, {"wet", num(r.wet.shear_modulus)}}},
+                 {"shear_modulus_error", {{"dry", num(dry_state.shear_modulus_error)}, {"wet", num(r.wet.shear_modulus_error)}}},
                  {"shear_modulus_second_difference",
                   {{"dry", num(dry_state.shear_modulus_fd)}, {"wet", num(r.wet.shear_modulus_fd)},
                    {"strain", opt.modulus_strain}}},

@@ -29,6 +29,7 @@ void shear_moduli(WetState& s, const NetworkEnergy& dry, const Eigen::Matrix2d& 
     const double A = std::abs((F * dry.model().box.B0()).determinant());
     const Modulus G = wet_linear_moduli(W, s.q, {shear_mode(F, A)}).front();
     s.shear_modulus = G.ok ? G.value : std::numeric_limits<double>::quiet_NaN();
+    s.shear_modulus_error = G.ok ? G.error : std::numeric_limits<double>::quiet_NaN();
 }
 }  // namespace
 
@@ -69,7 +70,8 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
         t0 = now();
         run.dry.pores = pores(m, dry.positions(run.dry.q, F), B);
         run.seconds_pores += now() - t0;
-        run.dry.shear_modulus = run.dry.shear_modulus_fd = std::numeric_limits<double>::quiet_NaN();
+        run.dry.shear_modulus = run.dry.shear_modulus_fd = run.dry.shear_modulus_error =
+            std::numeric_limits<double>::quiet_NaN();
         if (opt.moduli && run.dry.converged) {
             t0 = now();
             shear_moduli(run.dry, dry, F, {}, none, *solver, opt.modulus_strain);
@@ -98,7 +100,8 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     run.wet.pores = pores(m, x, B);
     run.bundles = bundles(m, x, B, run.active.bridges, opt.bundle_angle_deg);
     run.seconds_pores += now() - t0;
-    run.wet.shear_modulus = run.wet.shear_modulus_fd = std::numeric_limits<double>::quiet_NaN();
+    run.wet.shear_modulus = run.wet.shear_modulus_fd = run.wet.shear_modulus_error =
+        std::numeric_limits<double>::quiet_NaN();
     if (opt.moduli && run.wet.converged) {
         t0 = now();
         shear_moduli(run.wet, dry, F, run.active.bridges, opt.params, *solver, opt.modulus_strain);

@@ -114,6 +114,7 @@ struct WetState {
     // it when a capillary instability lies within that strain. NaN when not computed or when it failed (a saddle, a
     // relaxation that did not converge).
     double shear_modulus = 0;
+    double shear_modulus_error = 0;  // the linear modulus's error bound (Modulus::error): |G| below it is zero
     double shear_modulus_fd = 0;
     bool converged = false;
 };
