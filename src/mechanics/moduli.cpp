@@ -97,7 +97,8 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
     std::vector<Modulus> relaxed = relaxed_moduli(H, terms, modes, opt, &core, shared_llt);
     for (size_t m = 0; m < modes.size(); ++m) {
         relaxed[m].name = out[m].name;
-        relaxed[m].affine = at_affine ? modes[m].scale * relaxed[m].E_tt : out[m].affine;  // comoving E_tt: affine
+        // At the affine state the comoving E_tt is itself the affine prediction.
+        relaxed[m].affine = at_affine ? modes[m].scale * relaxed[m].E_tt : out[m].affine;
     }
     core.seconds_assembly += inf.seconds_assembly;
     core.seconds_affine = inf.seconds_affine;

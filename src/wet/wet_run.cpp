@@ -121,7 +121,7 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
                 WetEnergy W(dry, run.free_box.F, run.free_box.bridges, opt.params);
                 const double A = std::abs(Bf.determinant());
                 const Modulus G = wet_linear_moduli(W, run.free_box.q, {shear_mode(run.free_box.F, A)}).front();
-                if (G.ok) run.free_box.shear_modulus = G.value;
+                if (G.ok) run.free_box.shear_modulus = G.value, run.free_box.shear_modulus_error = G.error;
                 run.seconds_moduli += now() - t0;
             }
         } else {

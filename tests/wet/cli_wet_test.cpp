@@ -3,7 +3,10 @@
 
 #include "../support/cli_run.hpp"
 #include <cstdlib>
+#include <algorithm>
 #include <fstream>
+#include <sstream>
+#include <vector>
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -38,6 +41,39 @@ TEST_CASE("cli wet: a small run writes its documented outputs", "[wet][cli]") {
     CHECK(slurp(tmpdir() + "/stderr").empty());
 }
 
+TEST_CASE("cli wet: the shear moduli, linear and second difference, in the JSON and the sweep", "[wet][cli]") {
+    const std::string out = tmpdir() + "/moduli";
+    REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
+    // A rigid network (pl = 1) at beta = 0: the linear modulus and the second difference at 1e-5 agree.
+    REQUIRE(run("--L 2.5 --q 10 --pl 1 --seed 4 --beta 0 --modulus-strain 1e-5 -q -o " + out) == 0);
+    const std::string j = slurp(out + "/summary.json");
+    for (const char* key : {"\"shear_modulus\"", "\"shear_modulus_error\"", "\"shear_modulus_second_difference\"",
+                            "\"strain\": 1e-05"})
+        CHECK(j.find(key) != std::string::npos);
+    // The sweep's row: G_dry, G_wet (linear) and G_dry_fd, G_wet_fd (second difference), by the header's names.
+    std::istringstream csv(slurp(out + "/sweep.csv"));
+    std::string header, row;
+    REQUIRE(std::getline(csv, header));
+    REQUIRE(std::getline(csv, row));
+    auto fields = [](const std::string& line) {
+        std::vector<std::string> f;
+        std::stringstream ss(line);
+        for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+        return f;
+    };
+    const auto names = fields(header), values = fields(row);
+    REQUIRE(names.size() == values.size());
+    auto at = [&](const std::string& name) {
+        const auto it = std::find(names.begin(), names.end(), name);
+        REQUIRE(it != names.end());
+        return std::stod(values[static_cast<size_t>(it - names.begin())]);
+    };
+    INFO(header << "\n" << row);
+    CHECK(at("G_wet") > 1e-3);
+    CHECK(at("G_wet") == Approx(at("G_dry")).epsilon(1e-12));  // beta = 0: the wet network is the dry one
+    CHECK(at("G_wet_fd") == Approx(at("G_wet")).epsilon(1e-4));
+}
+
 TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
     const std::string out = tmpdir() + "/bad";
     REQUIRE(std::system(("mkdir -p " + out).c_str()) == 0);
@@ -61,6 +97,8 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
                           Case{"-q -v", "--verbose and --quiet"},
                           Case{"--modulus-strain -1e-4", "modulus strain = -0.0001"},
                           Case{"--modulus-strain nan", "modulus strain = nan"},
+                          Case{"--modulus-strain 0", "modulus strain = 0"},
+                          Case{"--modulus-strain 0.2", "modulus strain = 0.2"},
                           Case{"--modulus-strain 1e-4 --no-moduli", "--modulus-strain given with --no-moduli"}}) {
         INFO(c.args);
         CHECK(run("--L 2.5 --q 5 " + c.args + " -o " + out) == 2);
@@ -87,6 +125,13 @@ TEST_CASE("cli wet: --free-box reports the zero-stress box, and exit 1 when it i
     CHECK(csv.find(",converged,0.98039") != std::string::npos);  // s = 1 / 1.02 = 0.980392...
     CHECK(slurp(tmpdir() + "/stderr").find("free box iter") != std::string::npos);  // progress per iteration
     CHECK(slurp(out + "/pores.csv").find("free_box,0,") != std::string::npos);
+    // With the moduli: the linear shear modulus at the free box (the last column), here the reference's (pl = 1: rigid).
+    const std::string net_moduli = "--L 2.5 --q 10 --pl 1 --seed 4 --beta 0 --strain isotropic --gamma 0.02 --free-box";
+    REQUIRE(run(net_moduli + " --free-box-tol 1e-6 -q -o " + out + "/moduli") == 0);
+    const std::string csv_m = slurp(out + "/moduli/sweep.csv");
+    REQUIRE(csv_m.find(",free_box_iterations,G_free_box\n") != std::string::npos);
+    const std::string last = csv_m.substr(csv_m.rfind(',', csv_m.size() - 2) + 1);
+    CHECK(std::stod(last) > 1e-3);
     // A tolerance below round-off cannot be met: not converged, exit 1, and the JSON says so.
     CHECK(run(net + " --free-box-tol 1e-300") == 1);
     const std::string k = slurp(tmpdir() + "/stdout");

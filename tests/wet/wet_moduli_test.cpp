@@ -31,7 +31,8 @@ TEST_CASE("wet linear moduli: beta = 0 gives the dry linear moduli", "[wet][modu
     const double A = std::abs((F * m.box.B0()).determinant());
     const std::vector<StrainMode> modes{shear_mode(F, A), bulk_mode(F, A)};
     const auto dry = linear_moduli(e, q, F, modes);
-    // Bridges at every crossing, but beta = 0: no capillary term at all.
+    // Bridges at every crossing, but beta = 0: no capillary term is evaluated, so this checks the shared relaxed part
+    // (relaxed_moduli) and the plumbing of wet_linear_moduli, not the bridges' terms (the next test does).
     WetEnergy W(e, F, wet_crossings(net, m, e.positions(q, F), F * m.box.B0(), {}), WetParams{});
     const auto wet = wet_linear_moduli(W, q, modes);
     for (size_t k = 0; k < modes.size(); ++k) {

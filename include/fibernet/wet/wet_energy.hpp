@@ -41,10 +41,11 @@ public:
     // Each bridge's own energy at q (for reports and the continuity test).
     std::vector<double> bridge_energies(const Eigen::VectorXd& q) const;
 
-    // The derivatives along a strain path F(t) = F + t dF at fixed q (dE/dt, d2E/dq dt, d2E/dt2 of `out`; its energy and
-    // gradient are not filled): the dry terms' (NetworkEnergy::evaluate with kStrain) plus each bridge's. A bridge's
-    // coordinates move with F only through its nodes' periodic images and fixed nodes (X_a = x_a + F B0 n_a, x_a =
-    // F x_ref for a fixed node; linear in F), so dX/dt = dF r_a and its terms are g.w, H w and w.H w with w_a = dF r_a.
+    // The derivatives along a strain path F(t) = F + t dF at fixed q (dE/dt, d2E/dq dt, d2E/dt2 of `out`; its energy is
+    // the dry terms' only and its gradient is not filled): the dry terms' (NetworkEnergy::evaluate with kStrain) plus
+    // each bridge's. A bridge's coordinates move with F only through its nodes' periodic images and fixed nodes
+    // (X_a = x_a + F B0 n_a, x_a = F x_ref for a fixed node: linear in F), so dX_a/dt = w_a = dF r_a with r_a = B0 n_a
+    // (+ x_ref for a fixed node), d2X/dt2 = 0, and its terms are g.w, H w and w.H w.
     // For the wet linear moduli (wet_moduli.hpp).
     void strain_derivatives(const Eigen::VectorXd& q, const Eigen::Matrix2d& dF, EnergyEval& out) const;
 

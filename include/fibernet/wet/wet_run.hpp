@@ -88,7 +88,10 @@ struct FreeBoxResult {
     WetEvents events;             // summed over the accepted relaxations
     PoreStats pores;
     BundleStats bundles;
-    double shear_modulus = std::numeric_limits<double>::quiet_NaN();  // linear, bridge set frozen (wet_moduli.hpp), at F
+    // Linear shear modulus at F with the bridge set frozen (wet_moduli.hpp) and its error bound, of the state above
+    // (the last accepted one if not converged); NaN if not computed or if it failed.
+    double shear_modulus = std::numeric_limits<double>::quiet_NaN();
+    double shear_modulus_error = std::numeric_limits<double>::quiet_NaN();
     double seconds = 0;
 };
 
@@ -99,8 +102,8 @@ struct WetRunOptions {
     std::string solver = "newton";
     SolverOptions solver_options;
     double bundle_angle_deg = 10;
-    bool moduli = true;          // linear shear modulus dry and wet (one factorization each, and two relaxations each for
-                                 // the second difference at modulus_strain; see WetState)
+    bool moduli = true;          // linear shear modulus dry and wet (one factorization each, and three relaxations each
+                                 // for the second difference at modulus_strain; see WetState)
     double modulus_strain = 1e-4;
     FreeBoxOptions free_box;
 };
@@ -113,9 +116,9 @@ struct WetState {
     // second difference of relaxed energies at gamma = +-modulus_strain (relaxed_shear_modulus), which departs from
     // it when a capillary instability lies within that strain. NaN when not computed or when it failed (a saddle, a
     // relaxation that did not converge).
-    double shear_modulus = 0;
-    double shear_modulus_error = 0;  // the linear modulus's error bound (Modulus::error): |G| below it is zero
-    double shear_modulus_fd = 0;
+    double shear_modulus = std::numeric_limits<double>::quiet_NaN();
+    double shear_modulus_error = std::numeric_limits<double>::quiet_NaN();  // its bound (Modulus::error)
+    double shear_modulus_fd = std::numeric_limits<double>::quiet_NaN();
     bool converged = false;
 };
 
