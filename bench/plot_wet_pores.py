@@ -2,8 +2,10 @@
 """Pore growth against capillary strength over seeds, from bench/run_wet_pores.sh's output directory.
 
 Reads OUT/seed*/{summary.json,pores.csv} (one `fibernet wet --betas ...` sweep per network seed) and writes
-  OUT/runs.csv    one row per seed and beta (beta = "dry": the dry network): status, bridges, bundles, energies,
-                  shear modulus, and the pore measures below;
+  OUT/runs.csv    one row per seed and beta (beta = "dry": the dry network): status, bridges, bundles (fraction of
+                  fibers bundled, largest bundle, partners per bundled segment: 2 x aligned bridges / segments of
+                  bundled fibers, how many other fibers' segments a bundled segment lies along), energies, shear
+                  modulus, and the pore measures below;
   OUT/table.md    mean and standard deviation over the seeds per beta (stable runs only; the count says how many);
   OUT/pores.png   the pore measures against beta, one line per seed and the mean (needs matplotlib, Debian
                   python3-matplotlib; without it the tables are still written).
@@ -51,18 +53,24 @@ def read_seed(d):
             key = "dry" if row["state"] == "dry" else float(row["beta"])
             areas.setdefault(key, []).append(float(row["area"]))
     fibers = summary["network"]["fibers"]
+    seg_per_fiber = summary["model"]["segments"] / fibers
+
+    def partners(b):  # segments of other fibers that a bundled segment lies along, on average (2 per bridge)
+        return 2 * b["aligned_bridges"] / (b["bundled_fibers"] * seg_per_fiber) if b["bundled_fibers"] else 0.0
+
     rows = []
     for i, run in enumerate(summary["runs"]):
         if i == 0:  # the dry network (every beta starts from it)
             rows.append({"seed": seed, "beta": "dry", "status": "dry", "fibers": fibers, "bridges": "",
-                         "bundled_fraction": "", "largest_bundle": "", "E_capillary": 0.0,
+                         "bundled_fraction": "", "largest_bundle": "", "bundle_partners": "", "E_capillary": 0.0,
                          "E_bend": run["energy"]["dry"]["bend"], "G": run["shear_modulus"]["dry"],
                          **pore_measures(areas.get("dry", []))})
         beta = run["beta"]
         rows.append({"seed": seed, "beta": beta, "status": run["status"], "fibers": fibers,
                      "bridges": run["bridges"]["final"],
                      "bundled_fraction": run["bundles"]["bundled_fibers"] / fibers,
-                     "largest_bundle": run["bundles"]["largest"], "E_capillary": run["energy"]["wet"]["capillary"],
+                     "largest_bundle": run["bundles"]["largest"], "bundle_partners": partners(run["bundles"]),
+                     "E_capillary": run["energy"]["wet"]["capillary"],
                      "E_bend": run["energy"]["wet"]["bend"], "G": run["shear_modulus"]["wet"],
                      **pore_measures(areas.get(float(beta), []))})
     return summary.get("complete", False), rows
@@ -79,7 +87,8 @@ def main(out):
         rows.extend(r)
     if not rows:
         sys.exit(f"plot_wet_pores.py: no seed*/summary.json under {out}")
-    cols = ["seed", "beta", "status", "fibers", "bridges", "bundled_fraction", "largest_bundle", "E_capillary",
+    cols = ["seed", "beta", "status", "fibers", "bridges", "bundled_fraction", "largest_bundle", "bundle_partners",
+            "E_capillary",
             "E_bend", "G", "pores", "mean_area", "weighted_area", "d50", "largest_area"]
     with open(os.path.join(out, "runs.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=cols)
@@ -89,7 +98,8 @@ def main(out):
 
     keys = ["dry"] + sorted({r["beta"] for r in rows if r["beta"] != "dry"})
     measures = [("bridges", "bridges", "{:.0f}"), ("bundled_fraction", "bundled fibers", "{:.2f}"),
-                ("largest_bundle", "largest bundle", "{:.1f}"), ("E_capillary", "E_capillary", "{:.3g}"),
+                ("largest_bundle", "largest bundle", "{:.1f}"), ("bundle_partners", "partners per bundled segment", "{:.2f}"),
+                ("E_capillary", "E_capillary", "{:.3g}"),
                 ("G", "G", "{:.3g}"), ("pores", "pores", "{:.0f}"), ("mean_area", "mean area", "{:.2f}"),
                 ("weighted_area", "area-weighted mean area", "{:.1f}"), ("d50", "d50", "{:.2f}"),
                 ("largest_area", "largest pore", "{:.0f}")]
