@@ -41,7 +41,7 @@ def pore_measures(areas):
             "d50": d50, "largest_area": areas[-1]}
 
 
-def read_seed(d):
+def read_seed(d, study):
     seed = int(os.path.basename(d)[len("seed"):])
     with open(os.path.join(d, "summary.json")) as f:
         summary = json.load(f)
@@ -53,6 +53,7 @@ def read_seed(d):
             key = "dry" if row["state"] == "dry" else float(row["beta"])
             areas.setdefault(key, []).append(float(row["area"]))
     fibers = summary["network"]["fibers"]
+    pl = summary.get("parameters", {}).get("pl", study.get("pl", ""))
     seg_per_fiber = summary["model"]["segments"] / fibers
 
     def partners(b):  # segments of other fibers that a bundled segment lies along, on average (2 per bridge)
@@ -61,12 +62,12 @@ def read_seed(d):
     rows = []
     for i, run in enumerate(summary["runs"]):
         if i == 0:  # the dry network (every beta starts from it)
-            rows.append({"seed": seed, "beta": "dry", "status": "dry", "fibers": fibers, "bridges": "",
+            rows.append({"seed": seed, "beta": "dry", "status": "dry", "fibers": fibers, "pl": pl, "bridges": "",
                          "bundled_fraction": "", "largest_bundle": "", "bundle_partners": "", "E_capillary": 0.0,
                          "E_bend": run["energy"]["dry"]["bend"], "G": run["shear_modulus"]["dry"],
                          **pore_measures(areas.get("dry", []))})
         beta = run["beta"]
-        rows.append({"seed": seed, "beta": beta, "status": run["status"], "fibers": fibers,
+        rows.append({"seed": seed, "beta": beta, "status": run["status"], "fibers": fibers, "pl": pl,
                      "bridges": run["bridges"]["final"],
                      "bundled_fraction": run["bundles"]["bundled_fibers"] / fibers,
                      "largest_bundle": run["bundles"]["largest"], "bundle_partners": partners(run["bundles"]),
@@ -78,16 +79,18 @@ def read_seed(d):
 
 def main(out):
     rows, incomplete = [], []
+    study_path = os.path.join(out, "study.json")  # written by run_wet_pores.sh
+    study = json.load(open(study_path)) if os.path.exists(study_path) else {}
     dirs = [d for d in glob.glob(os.path.join(out, "seed*"))
             if os.path.isdir(d) and os.path.basename(d)[4:].isdigit() and os.path.exists(os.path.join(d, "summary.json"))]
     for d in sorted(dirs, key=lambda p: int(os.path.basename(p)[4:])):
-        complete, r = read_seed(d)
+        complete, r = read_seed(d, study)
         if not complete:
             incomplete.append(os.path.basename(d))
         rows.extend(r)
     if not rows:
         sys.exit(f"plot_wet_pores.py: no seed*/summary.json under {out}")
-    cols = ["seed", "beta", "status", "fibers", "bridges", "bundled_fraction", "largest_bundle", "bundle_partners",
+    cols = ["seed", "beta", "status", "fibers", "pl", "bridges", "bundled_fraction", "largest_bundle", "bundle_partners",
             "E_capillary",
             "E_bend", "G", "pores", "mean_area", "weighted_area", "d50", "largest_area"]
     with open(os.path.join(out, "runs.csv"), "w", newline="") as f:
@@ -172,8 +175,9 @@ def main(out):
         ax.grid(alpha=0.3)
     axes.flat[0].legend()
     fibers = rows[0]["fibers"]
-    fig.suptitle(f"Wet networks of {fibers} fibers (q = 10, pl = 0.5): pores against capillary strength, "
-                 f"{len(seeds)} seeds")
+    pl = rows[0].get("pl", "")
+    fig.suptitle(f"Wet networks of {fibers} fibers (q = 10{f', pl = {pl}' if pl != '' else ''}): pores against "
+                 f"capillary strength, {len(seeds)} seeds")
     fig.tight_layout()
     fig.savefig(os.path.join(out, "pores.png"), dpi=110)
 

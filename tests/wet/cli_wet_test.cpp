@@ -27,6 +27,8 @@ TEST_CASE("cli wet: a small run writes its documented outputs", "[wet][cli]") {
     for (const char* f : {"summary.json", "sweep.csv", "pores.csv", "network.svg", "pores.svg"}) CHECK(exists(out + "/" + f));
     const std::string j = slurp(out + "/summary.json");
     CHECK(j.find("\"capillary\"") != std::string::npos);
+    CHECK(j.find("\"parameters\"") != std::string::npos);  // what generated the network
+    CHECK(j.find("\"pl\": 1.0") != std::string::npos);
     CHECK(j.find("\"stable\"") != std::string::npos);
     CHECK(j.find("\"local_rounds\": 0") != std::string::npos);  // beta = 0: one global solve
     CHECK(j.find("\"complete\": true") != std::string::npos);  // false in the copies written between betas
