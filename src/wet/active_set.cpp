@@ -642,9 +642,12 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         // A local round that left the set as it was is no repeat: the rest of the network has not been solved yet. The
         // next round is global: with no events left to chase, regions with held boundaries pass the residual from one
         // to the next (at 3000 fibers max|g| fell from 1.6e-2 to 1e-2 over 150 such rounds) where one global solve ends it.
+        // That global round keeps the cap decided when the set last changed (below): uncapped if that change returned
+        // to a set seen before, so that a toggle is judged after a finished solve. Resetting the cap here hid a cycle
+        // (a bridge ruptured and re-formed by alternate cut global rounds, a quiet local round between each: 1000 fibers,
+        // pl = 0.8, seed 4, beta = 0.1 ran 1300 rounds until the round limit; docs/wet.md, "Breaking a cycle").
         if (local && sig == history.back()) {
             region.clear();
-            capped = cap;
             continue;
         }
         // The next round is capped only if this one changed the set to one not seen before: once it has settled, or
