@@ -220,17 +220,8 @@ void register_wet(CLI::App& app) {
         std::vector<std::string> hist_names;
         std::vector<std::vector<double>> hist_values;
         auto summary = [&](bool complete) {
-            // What generated the network and its model, so that a summary says which network it describes.
-            nlohmann::json generator =
-                s.network_file.empty()
-                    ? nlohmann::json{{"L", s.mikado.L}, {"q", s.mikado.q}, {"pl", s.mikado.pl},
-                                     {"seed", s.mikado.seed}, {"periodic", s.mikado.periodic}}
-                    : nlohmann::json{{"network_file", s.network_file}};
-            generator["scheme"] = to_string(s.discretization.scheme);
-            generator["n_seg"] = s.discretization.n_seg, generator["h"] = s.discretization.h;
-            generator["a"] = s.discretization.aspect_ratio;
             return nlohmann::json{{"scene", s.source},
-                                {"parameters", generator},
+                                {"parameters", scene_parameters(s)},  // which network the summary describes
                                 {"network", to_json(statistics(net))},
                                 {"model", to_json(summarize(m))},
                                 {"wet",

@@ -115,6 +115,16 @@ nlohmann::json prune_rules(const Scene& s) {
     return j;
 }
 
+nlohmann::json scene_parameters(const Scene& s) {
+    nlohmann::json j = s.network_file.empty()
+                           ? nlohmann::json{{"L", s.mikado.L}, {"q", s.mikado.q}, {"pl", s.mikado.pl},
+                                            {"seed", s.mikado.seed}, {"periodic", s.mikado.periodic}}
+                           : nlohmann::json{{"network_file", s.network_file}};
+    j["scheme"] = to_string(s.discretization.scheme);
+    j["n_seg"] = s.discretization.n_seg, j["h"] = s.discretization.h, j["a"] = s.discretization.aspect_ratio;
+    return j;
+}
+
 void refuse_trimmed_ends(const Scene& s, const std::string& command, const std::string& why) {
     if (s.discretization.trim_ends)
         throw InputError(s.source + ": prune \"ends\" is not valid for `fibernet " + command + "`: " + why);

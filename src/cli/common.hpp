@@ -35,6 +35,8 @@ void refuse_trimmed_ends(const Scene& s, const std::string& command, const std::
 
 nlohmann::json to_json(const NetworkStats& s);
 nlohmann::json prune_rules(const Scene& s);  // the pruning rules applied, e.g. ["dangling", "ends"]
+// What generates the scene's network and model: L, q, pl, seed, periodic (or the network file), scheme, n_seg, h, a.
+nlohmann::json scene_parameters(const Scene& s);
 nlohmann::json to_json(const ModelSummary& s);
 
 // Prints JSON to stdout (or to `path` atomically when non-empty).

@@ -82,11 +82,6 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
         for (size_t m = 0; m < modes.size(); ++m) out[m].affine = modes[m].scale * out[m].E_tt;  // all nodes fixed
     }
     inf.seconds_affine = since(t0);
-    if (n == 0) {  // nothing can relax: the modulus is the affine term
-        for (size_t m = 0; m < modes.size(); ++m) out[m].value = modes[m].scale * out[m].E_tt, out[m].ok = true;
-        inf.seconds_total = since(t_start);
-        return out;
-    }
 
     // The relaxed part, in comoving coordinates (relaxed_moduli).
     const Eigen::VectorXd x = e.positions(q, F);  // absolute positions: the affine velocity is dF F^-1 x

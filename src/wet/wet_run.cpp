@@ -20,16 +20,21 @@ double now() {
 }  // namespace
 
 namespace {
+// The linear shear modulus at (q, F) with the bridge set frozen and its error bound; NaN for both if it failed.
+void linear_shear_modulus(const NetworkEnergy& dry, const Eigen::Matrix2d& F, const Eigen::VectorXd& q,
+                          const std::vector<Bridge>& bridges, const WetParams& params, double& G, double& error) {
+    WetEnergy W(dry, F, bridges, params);
+    const Modulus M = wet_linear_moduli(W, q, {shear_mode(F, std::abs((F * dry.model().box.B0()).determinant()))}).front();
+    G = M.ok ? M.value : std::numeric_limits<double>::quiet_NaN();
+    error = M.ok ? M.error : std::numeric_limits<double>::quiet_NaN();
+}
+
 // WetState's two shear moduli at (q, F) with the bridge set frozen: the second difference first (its solves leave
 // the solver as before the exact modulus existed, so what follows, e.g. the free box, takes the same path).
 void shear_moduli(WetState& s, const NetworkEnergy& dry, const Eigen::Matrix2d& F, const std::vector<Bridge>& bridges,
                   const WetParams& params, Solver& solver, double h) {
     s.shear_modulus_fd = relaxed_shear_modulus(dry, F, s.q, bridges, params, solver, h);
-    WetEnergy W(dry, F, bridges, params);
-    const double A = std::abs((F * dry.model().box.B0()).determinant());
-    const Modulus G = wet_linear_moduli(W, s.q, {shear_mode(F, A)}).front();
-    s.shear_modulus = G.ok ? G.value : std::numeric_limits<double>::quiet_NaN();
-    s.shear_modulus_error = G.ok ? G.error : std::numeric_limits<double>::quiet_NaN();
+    linear_shear_modulus(dry, F, s.q, bridges, params, s.shear_modulus, s.shear_modulus_error);
 }
 }  // namespace
 
@@ -70,8 +75,6 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
         t0 = now();
         run.dry.pores = pores(m, dry.positions(run.dry.q, F), B);
         run.seconds_pores += now() - t0;
-        run.dry.shear_modulus = run.dry.shear_modulus_fd = run.dry.shear_modulus_error =
-            std::numeric_limits<double>::quiet_NaN();
         if (opt.moduli && run.dry.converged) {
             t0 = now();
             shear_moduli(run.dry, dry, F, {}, none, *solver, opt.modulus_strain);
@@ -100,8 +103,6 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     run.wet.pores = pores(m, x, B);
     run.bundles = bundles(m, x, B, run.active.bridges, opt.bundle_angle_deg);
     run.seconds_pores += now() - t0;
-    run.wet.shear_modulus = run.wet.shear_modulus_fd = run.wet.shear_modulus_error =
-        std::numeric_limits<double>::quiet_NaN();
     if (opt.moduli && run.wet.converged) {
         t0 = now();
         shear_moduli(run.wet, dry, F, run.active.bridges, opt.params, *solver, opt.modulus_strain);
@@ -115,13 +116,10 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
             const Eigen::VectorXd xf = dry.positions(run.free_box.q, run.free_box.F);
             run.free_box.pores = pores(m, xf, Bf);
             run.free_box.bundles = bundles(m, xf, Bf, run.free_box.bridges, opt.bundle_angle_deg);
-            run.free_box.shear_modulus = std::numeric_limits<double>::quiet_NaN();
             if (opt.moduli) {
                 t0 = now();
-                WetEnergy W(dry, run.free_box.F, run.free_box.bridges, opt.params);
-                const double A = std::abs(Bf.determinant());
-                const Modulus G = wet_linear_moduli(W, run.free_box.q, {shear_mode(run.free_box.F, A)}).front();
-                if (G.ok) run.free_box.shear_modulus = G.value, run.free_box.shear_modulus_error = G.error;
+                linear_shear_modulus(dry, run.free_box.F, run.free_box.q, run.free_box.bridges, opt.params,
+                                     run.free_box.shear_modulus, run.free_box.shear_modulus_error);
                 run.seconds_moduli += now() - t0;
             }
         } else {
