@@ -4,8 +4,9 @@
 Reads OUT/seed*/{summary.json,pores.csv} (one `fibernet wet --betas ...` sweep per network seed) and writes
   OUT/runs.csv    one row per seed and beta (beta = "dry": the dry network): status, bridges, bundles (fraction of
                   fibers bundled, largest bundle, partners per bundled segment: 2 x aligned bridges / segments of
-                  bundled fibers, how many other fibers' segments a bundled segment lies along), energies, shear
-                  modulus, and the pore measures below;
+                  bundled fibers, how many other fibers' segments a bundled segment lies along; capped: aligned
+                  crossings and contacts left without a bridge by --bundle-partners), energies, shear modulus, the
+                  pore measures below, and the wet relaxation's seconds (solve + events, moduli and pores excluded);
   OUT/table.md    mean and standard deviation over the seeds per beta (stable runs only; the count says how many);
   OUT/pores.png   the pore measures against beta, one line per seed and the mean (needs matplotlib, Debian
                   python3-matplotlib; without it the tables are still written).
@@ -63,7 +64,8 @@ def read_seed(d, study):
     for i, run in enumerate(summary["runs"]):
         if i == 0:  # the dry network (every beta starts from it)
             rows.append({"seed": seed, "beta": "dry", "status": "dry", "fibers": fibers, "pl": pl, "bridges": "",
-                         "bundled_fraction": "", "largest_bundle": "", "bundle_partners": "", "E_capillary": 0.0,
+                         "bundled_fraction": "", "largest_bundle": "", "bundle_partners": "", "capped": "",
+                         "E_capillary": 0.0, "seconds": "",
                          "E_bend": run["energy"]["dry"]["bend"], "G": run["shear_modulus"]["dry"],
                          **pore_measures(areas.get("dry", []))})
         beta = run["beta"]
@@ -71,6 +73,8 @@ def read_seed(d, study):
                      "bridges": run["bridges"]["final"],
                      "bundled_fraction": run["bundles"]["bundled_fibers"] / fibers,
                      "largest_bundle": run["bundles"]["largest"], "bundle_partners": partners(run["bundles"]),
+                     "capped": run["events"].get("capped", 0),
+                     "seconds": run["seconds"]["wet_solve"] + run["seconds"]["events"],
                      "E_capillary": run["energy"]["wet"]["capillary"],
                      "E_bend": run["energy"]["wet"]["bend"], "G": run["shear_modulus"]["wet"],
                      **pore_measures(areas.get(float(beta), []))})
@@ -91,7 +95,7 @@ def main(out):
     if not rows:
         sys.exit(f"plot_wet_pores.py: no seed*/summary.json under {out}")
     cols = ["seed", "beta", "status", "fibers", "pl", "bridges", "bundled_fraction", "largest_bundle", "bundle_partners",
-            "E_capillary",
+            "capped", "E_capillary", "seconds",
             "E_bend", "G", "pores", "mean_area", "weighted_area", "d50", "largest_area"]
     with open(os.path.join(out, "runs.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=cols)
@@ -102,10 +106,10 @@ def main(out):
     keys = ["dry"] + sorted({r["beta"] for r in rows if r["beta"] != "dry"})
     measures = [("bridges", "bridges", "{:.0f}"), ("bundled_fraction", "bundled fibers", "{:.2f}"),
                 ("largest_bundle", "largest bundle", "{:.1f}"), ("bundle_partners", "partners per bundled segment", "{:.2f}"),
-                ("E_capillary", "E_capillary", "{:.3g}"),
+                ("capped", "capped (bundle_partners)", "{:.0f}"), ("E_capillary", "E_capillary", "{:.3g}"),
                 ("G", "G", "{:.3g}"), ("pores", "pores", "{:.0f}"), ("mean_area", "mean area", "{:.2f}"),
                 ("weighted_area", "area-weighted mean area", "{:.1f}"), ("d50", "d50", "{:.2f}"),
-                ("largest_area", "largest pore", "{:.0f}")]
+                ("largest_area", "largest pore", "{:.0f}"), ("seconds", "wet solve + events, s", "{:.1f}")]
 
     def stat(key, m):
         v = [r[m] for r in rows if r["beta"] == key and r["status"] in ("dry", "stable") and r[m] != ""]
@@ -116,8 +120,9 @@ def main(out):
         return mean, statistics.stdev(v) if len(v) > 1 else 0.0, len(v)
 
     seeds = sorted({r["seed"] for r in rows})
+    extra = f" Extra flags: `{study['extra']}`." if study.get("extra") else ""
     lines = [f"Mean +- standard deviation over {len(seeds)} network seeds ({', '.join(map(str, seeds))}); "
-             f"stable runs only (n).", ""]
+             f"stable runs only (n).{extra}", ""]
     lines.append("| beta | n | " + " | ".join(label for _, label, _ in measures) + " |")
     lines.append("|---" * (len(measures) + 2) + "|")
     for key in keys:

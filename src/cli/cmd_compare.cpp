@@ -4,12 +4,14 @@
 // Dense eigen-decompositions: for small networks. Exit code 1 if any network disagrees.
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "common.hpp"
 #include "fibernet/util/error.hpp"
 #include "fibernet/rigidity/compare.hpp"
 
 namespace fibernet::cli {
+
 
 namespace {
 nlohmann::json row(std::uint64_t seed, const RigidityComparison& c) {
@@ -44,6 +46,8 @@ void register_compare(CLI::App& app) {
     cmd->add_option("--g-cut", *g_cut, "clamped shear moduli > this are nonzero (default 7e-7)");
     cmd->add_option("--max-dofs", *max_dofs, "refuse networks with more coordinates than this (dense, default 3000)");
     cmd->add_option("--out", *out, "write the JSON to this file instead of stdout");
+    auto quiet = std::make_shared<bool>(false);
+    cmd->add_flag("-q,--quiet", *quiet, "no progress lines on stderr (default: one per network)");
     cmd->footer("Without a scene file the discretization defaults to the tested one: --scheme even --h 10 --a 3.");
     cmd->callback([=] {
         Scene s = flags->resolve();
@@ -58,6 +62,7 @@ void register_compare(CLI::App& app) {
         check_value(*g_cut > 0, *g_cut, "command line", "--g-cut", "must be > 0");
         if (!s.network_file.empty() && *samples != 1)
             throw InputError("command line: --samples " + std::to_string(*samples) + " needs a generated network, not --network");
+        check_outputs({{"--out", *out}});
         const auto t0 = std::chrono::steady_clock::now();
         int agree = 0;
         double max_zero = 0, min_nonzero = 0, max_G_free = 0, min_G_rigid = 0;
@@ -68,12 +73,23 @@ void register_compare(CLI::App& app) {
             si.mikado.seed = s.mikado.seed + static_cast<std::uint64_t>(i);
             const Network net = scene_network(si);
             if (net.periodic)
-                throw InputError(s.source + ": the box is periodic; the comparison needs an open box (add --open)");
+                throw InputError(s.source + ": the box is periodic; the comparison needs an open box (" +
+                                 (s.network_file.empty() ? std::string("add --open")
+                                                         : "the network file '" + s.network_file + "' has a periodic box") +
+                                 ")");
             const long coords = static_cast<long>(discretize(net, si.discretization).x.size());
             if (coords > *max_dofs)
                 throw InputError(s.source + ": the model has " + std::to_string(coords) + " coordinates, more than --max-dofs " +
                                  std::to_string(*max_dofs) + " for dense eigen-decompositions (use a smaller L or a larger --h)");
+            const auto t_sample = std::chrono::steady_clock::now();
             const RigidityComparison c = compare_rigidity(net, si.discretization, *zero_cut, *g_cut);
+            if (!*quiet)
+                std::fprintf(stderr,
+                             "compare: network %d of %d (seed %llu): %d fibers, %ld coordinates, %ld floppy modes, "
+                             "Hessian nullity %ld, d = %d, G = %.3g: %s, %.2f s\n",
+                             i + 1, *samples, static_cast<unsigned long long>(si.mikado.seed), c.fibers, coords,
+                             c.floppy_modes, c.nullity, c.d, c.G, c.agrees() ? "agrees" : "DISAGREES",
+                             seconds_since(t_sample));
             agree += c.agrees();
             max_zero = std::max({max_zero, c.largest_zero, c.clamped_largest_zero});
             for (double v : {c.smallest_nonzero, c.clamped_smallest_nonzero})

@@ -9,6 +9,7 @@
 #include "fibernet/mechanics/stress.hpp"
 #include "fibernet/solve/newton.hpp"
 #include "fibernet/solve/solver.hpp"
+#include "fibernet/util/error.hpp"
 
 namespace fibernet::cli {
 
@@ -47,8 +48,11 @@ void register_modulus(CLI::App& app) {
     auto start = std::make_shared<std::string>("affine");
     cmd->add_option("--start", *start, "start of a strained solve: affine (default) | linear (affine + linear response)")
         ->check(CLI::IsMember({"affine", "linear"}));
-    cmd->add_flag("-v,--verbose", *verbose, "solver progress on stderr");
-    cmd->callback([flags, verbose, start] {
+    cmd->add_flag("-v,--verbose", *verbose, "solver progress on stderr (a line per iteration)");
+    auto quiet = std::make_shared<bool>(false);
+    cmd->add_flag("-q,--quiet", *quiet, "no progress lines on stderr");
+    cmd->callback([flags, verbose, quiet, start] {
+        if (*verbose && *quiet) throw InputError("--verbose and --quiet contradict each other");
         const auto t_all = std::chrono::steady_clock::now();
         Scene s = flags->resolve();
         SolverOptions so;
@@ -64,8 +68,11 @@ void register_modulus(CLI::App& app) {
         const double t_model = seconds_since(t0);
 
         const Eigen::Matrix2d F = deformation(s.strain, s.gamma);
+        const Progress progress("modulus", !*quiet);
+        progress.start(net, e, s);
         Equilibrium eq = relax(e, F, *solver, nullptr, Eigen::Matrix2d::Identity(), *start == "linear");
         const bool conv = eq.converged();
+        progress.solved(eq.result);
 
         nlohmann::json moduli = nullptr, stress_j = nullptr, lin = nullptr;
         bool ok = conv;
@@ -116,6 +123,7 @@ void register_modulus(CLI::App& app) {
                    {"seconds",
                     {{"network", t_net}, {"model", t_model}, {"equilibrium", eq.result.timings.total},
                      {"total", seconds_since(t_all)}}}});
+        progress.line(ok ? "done" : conv ? "the linear moduli failed (status modulus_failed)" : "not converged", t_all);
         if (!ok) exit_code() = 1;
     });
 }

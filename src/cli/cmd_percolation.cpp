@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -25,6 +26,7 @@
 #include "fibernet/rigidity/percolation_fit.hpp"
 
 namespace fibernet::cli {
+
 
 namespace {
 const char* kHeader = "pl,L,q,sample,seed,fibers,d,rigid_spanning,connected_spanning,seconds";
@@ -44,8 +46,12 @@ std::string csv_line(const PercolationSample& s) {
 
 using Key = std::tuple<std::string, std::string, int>;  // L, q as written, sample
 
-// Reads the rows of an existing CSV; lines that do not parse (an interrupted write) are skipped.
-std::vector<PercolationSample> read_rows(const std::string& path, double pl, bool& ends_with_newline) {
+// Reads the rows of an existing CSV; lines that do not parse (an interrupted write) are skipped. Refuses rows that
+// this run's --pl and --seed would not have made: resuming them would mix two runs. seed_of(row) is the seed the
+// base seed gives for the row's L, q and sample.
+std::vector<PercolationSample> read_rows(const std::string& path, double pl, std::uint64_t base_seed,
+                                         const std::function<std::uint64_t(const PercolationSample&)>& seed_of,
+                                         bool& ends_with_newline) {
     std::ifstream in(path);
     std::vector<PercolationSample> rows;
     std::string line;
@@ -69,6 +75,11 @@ std::vector<PercolationSample> read_rows(const std::string& path, double pl, boo
         if (std::abs(s.pl - pl) > 1e-12)
             throw InputError(path + ":" + std::to_string(lineno) + ": pl = " + fmt(s.pl) + " differs from --pl " + fmt(pl));
         s.seed = seed, s.rigid = rigid, s.connected = conn;
+        if (s.seed != seed_of(s))
+            throw InputError(path + ":" + std::to_string(lineno) + ": seed = " + std::to_string(s.seed) + " of L = " +
+                             fmt(s.L) + ", q = " + fmt(s.q) + ", sample " + std::to_string(s.sample) +
+                             " is not the seed --seed " + std::to_string(base_seed) + " gives (" +
+                             std::to_string(seed_of(s)) + "): the CSV was written with another --seed");
         rows.push_back(s);
     }
     return rows;
@@ -130,7 +141,7 @@ void register_percolation(CLI::App& app) {
     cmd->add_option("--q-max", o->q_max, "last density")->required();
     cmd->add_option("--q-step", o->q_step, "density step")->required();
     cmd->add_option("--samples", o->samples, "networks per (L, q)")->required();
-    cmd->add_option("--seed", o->seed, "base seed (default 1)");
+    cmd->add_option("--seed", o->seed, "base seed, an integer in [0, 2^64) (default 1)")->check(seed_check());
     cmd->add_option("--threads", o->threads, "worker threads (default 2)");
     cmd->add_option("--out", o->out, "CSV of samples, appended per sample")->required();
     cmd->add_flag("--resume", o->resume, "continue an existing CSV: run only the samples it lacks");
@@ -146,13 +157,28 @@ void register_percolation(CLI::App& app) {
         check_value((o->q_max - o->q_min) / o->q_step <= 10000, o->q_step, w, "--q-step", "gives more than 10000 densities");
         check_value(o->samples >= 1 && o->samples <= 1000000, o->samples, w, "--samples", "must lie in [1, 1e6]");
         check_value(o->threads >= 1 && o->threads <= 256, o->threads, w, "--threads", "must lie in [1, 256]");
+        check_outputs({{"--out", o->out}, {"--table", o->table}, {"--summary", o->summary}});
+        // This run's (L, q) values, by their CSV text: a row's seed is checked against the exact values where the
+        // 10 digits written lost some.
+        std::map<std::pair<std::string, std::string>, std::pair<double, double>> grid;
+        const int nq = static_cast<int>(std::floor((o->q_max - o->q_min) / o->q_step + 1e-9)) + 1;
+        for (double L : o->L)
+            for (int k = 0; k < nq; ++k) {
+                const double q = std::round((o->q_min + k * o->q_step) * 1e9) / 1e9;
+                grid[{fmt(L), fmt(q)}] = {L, q};
+            }
+        auto seed_of = [&](const PercolationSample& r) {
+            auto it = grid.find({fmt(r.L), fmt(r.q)});
+            return it == grid.end() ? percolation_seed(o->seed, r.L, r.q, r.sample)
+                                    : percolation_seed(o->seed, it->second.first, it->second.second, r.sample);
+        };
         std::vector<PercolationSample> rows;
         bool newline = true;
         {
             std::ifstream probe(o->out);
             if (probe.good()) {
                 if (!o->resume) throw InputError(w + ": --out " + o->out + " exists; add --resume to continue it");
-                rows = read_rows(o->out, o->pl, newline);
+                rows = read_rows(o->out, o->pl, o->seed, seed_of, newline);
             }
         }
         std::set<Key> done;
@@ -162,7 +188,6 @@ void register_percolation(CLI::App& app) {
             int sample;
         };
         std::vector<Item> todo;
-        const int nq = static_cast<int>(std::floor((o->q_max - o->q_min) / o->q_step + 1e-9)) + 1;
         for (double L : o->L)
             for (int k = 0; k < nq; ++k) {
                 const double q = std::round((o->q_min + k * o->q_step) * 1e9) / 1e9;

@@ -9,6 +9,7 @@
 #include "fibernet/model/model_io.hpp"
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/solve/solver.hpp"
+#include "fibernet/util/error.hpp"
 
 namespace fibernet::cli {
 
@@ -25,9 +26,14 @@ void register_relax(CLI::App& app) {
     cmd->add_option("--start", *start, "start of a strained solve: affine (default) | linear (affine + linear response)")
         ->check(CLI::IsMember({"affine", "linear"}));
     cmd->add_option("-o,--output", *out, "write the equilibrium model here (export format, docs/formats.md)");
-    cmd->add_flag("-v,--verbose", *verbose, "solver progress on stderr");
-    cmd->callback([flags, out, verbose, start] {
+    cmd->add_flag("-v,--verbose", *verbose, "solver progress on stderr (a line per iteration)");
+    auto quiet = std::make_shared<bool>(false);
+    cmd->add_flag("-q,--quiet", *quiet, "no progress lines on stderr");
+    cmd->callback([flags, out, verbose, quiet, start] {
+        const auto t_all = std::chrono::steady_clock::now();
+        if (*verbose && *quiet) throw InputError("--verbose and --quiet contradict each other");
         Scene s = flags->resolve();
+        check_outputs({{"--output", *out}});  // before the solve, not after it
         SolverOptions so;
         so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.verbose = *verbose;
         auto solver = make_solver(s.solver.name, so);
@@ -35,7 +41,10 @@ void register_relax(CLI::App& app) {
         Model m = discretize(net, s.discretization);
         NetworkEnergy e(m);
         const Eigen::Matrix2d F = deformation(s.strain, s.gamma);
+        const Progress progress("relax", !*quiet);
+        progress.start(net, e, s);
         Equilibrium eq = relax(e, F, *solver, nullptr, Eigen::Matrix2d::Identity(), *start == "linear");
+        progress.solved(eq.result);
         nlohmann::json st = nullptr;
         if (eq.converged()) {
             st = stress_json(stress(e, eq.q, F));
@@ -58,6 +67,7 @@ void register_relax(CLI::App& app) {
                    {"solver", solve_json(eq.result, s.solver.tol)},
                    {"start", eq.start},
                    {"output", eq.converged() && !out->empty() ? nlohmann::json(*out) : nlohmann::json()}});
+        progress.line(eq.converged() ? "done" : "not converged", t_all);
     });
 }
 

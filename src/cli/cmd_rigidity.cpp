@@ -14,6 +14,7 @@
 
 namespace fibernet::cli {
 
+
 namespace {
 nlohmann::json counts(const RigidityResult& r) {
     nlohmann::json j = {{"bodies", r.bodies},
@@ -52,11 +53,15 @@ void register_rigidity(CLI::App& app) {
     cmd->callback([=] {
         Scene s = flags->resolve();
         refuse_trimmed_ends(s, "rigidity", "the pebble game treats whole fibers as rigid rods");
+        check_outputs({{"--svg", *svg}, {"--out", *out}});
         auto t0 = std::chrono::steady_clock::now();
         const Network net = scene_network(s);
         const double t_net = seconds_since(t0);
         if (net.periodic)
-            throw InputError(s.source + ": the box is periodic; rigidity counts open boxes with clamps (add --open)");
+            throw InputError(s.source + ": the box is periodic; rigidity counts open boxes with clamps (" +
+                             (s.network_file.empty() ? std::string("add --open")
+                                                     : "the network file '" + s.network_file + "' has a periodic box") +
+                             ")");
         t0 = std::chrono::steady_clock::now();
         const RigidityResult open = analyze_rigidity(body_pin_framework(net));
         const double t_open = seconds_since(t0);

@@ -1,11 +1,14 @@
 // fibernet sweep: quasistatic strain sweep with an adaptive step (include/fibernet/mechanics/sweep.hpp).
 // One CSV row per accepted step, flushed at once, and a checkpoint after every step: Ctrl-C (SIGINT/SIGTERM)
 // stops after the step in progress, and --resume continues with results identical to an uninterrupted run.
+
 #include <atomic>
 #include <csignal>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "common.hpp"
@@ -32,39 +35,88 @@ std::string csv_row(const SweepRow& r) {
     return os.str();
 }
 
-void write_checkpoint(const std::string& path, const SweepParams& p, int rows, const SweepState& s) {
+// Everything that determines the rows: a checkpoint records it, and --resume refuses any difference.
+nlohmann::json sweep_parameters(const Scene& s, const SweepParams& p) {
+    nlohmann::json j = scene_parameters(s);
+    if (!s.network_file.empty()) {  // the file's content, not only its name, makes the network
+        std::ifstream is(s.network_file, std::ios::binary);
+        std::uint64_t h = 1469598103934665603ull;  // FNV-1a
+        for (char c; is.get(c);) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+        j["network_file_fnv1a"] = h;
+    }
+    j["fiber_length"] = s.discretization.fiber_length;
+    j["prune"] = prune_rules(s);
+    j["strain"] = to_string(p.kind);
+    j["solver"] = s.solver.name, j["tol"] = s.solver.tol, j["max_iter"] = s.solver.max_iter;
+    j["gamma_max"] = p.t_max, j["step"] = p.step, j["min_step"] = p.min_step, j["max_step"] = p.max_step;
+    j["good_iterations"] = p.good_iterations, j["max_iterations"] = p.max_iterations, j["grow"] = p.grow;
+    return j;
+}
+
+// The flag that sets a recorded parameter, for messages.
+std::string flag_of(const std::string& key) {
+    static const std::map<std::string, std::string> flags = {
+        {"L", "--L"},           {"q", "--q"},           {"pl", "--pl"},           {"seed", "--seed"},
+        {"periodic", "--open"}, {"network_file", "--network"}, {"network_file_fnv1a", "--network (content)"},
+        {"scheme", "--scheme"}, {"n_seg", "--nseg"},    {"h", "--h"},             {"a", "--a"},
+        {"prune", "--prune"},   {"strain", "--strain"}, {"solver", "--solver"},   {"tol", "--tol"},
+        {"max_iter", "--max-iter"}, {"gamma_max", "--gamma-max"}, {"step", "--step"}, {"min_step", "--min-step"},
+        {"max_step", "--max-step"}};
+    auto it = flags.find(key);
+    return it == flags.end() ? "" : " (" + it->second + ")";
+}
+
+std::string shown(const nlohmann::json& v) { return v.is_null() ? "(none)" : v.is_string() ? v.get<std::string>() : v.dump(); }
+
+void write_checkpoint(const std::string& path, const nlohmann::json& params, int rows, const SweepState& s) {
     std::ostringstream os;
-    os << std::setprecision(17) << "fibernet-sweep-checkpoint 1\nkind " << to_string(p.kind) << "\nt_max " << p.t_max
-       << "\ndofs " << s.q.size() << "\nrows " << rows << "\nstep " << s.step << "\nt " << s.t << "\nnext_step "
-       << s.next_step << "\nq\n";
+    os << std::setprecision(17) << "fibernet-sweep-checkpoint 2\nparameters " << params.dump() << "\ndofs "
+       << s.q.size() << "\nrows " << rows << "\nstep " << s.step << "\nt " << s.t << "\nnext_step " << s.next_step
+       << "\nq\n";
     for (int i = 0; i < s.q.size(); ++i) os << s.q[i] << '\n';
     write_file_atomic(path, os.str());
 }
 
-SweepState read_checkpoint(const std::string& path, const SweepParams& p, int dofs, int& rows) {
+struct Checkpoint {
+    int dofs = 0, rows = 0;
+    SweepState state;
+};
+
+// Reads a checkpoint and refuses it unless it was written with this run's parameters (each difference is named).
+Checkpoint read_checkpoint(const std::string& path, const nlohmann::json& params) {
     std::ifstream is(path);
     if (!is) throw InputError("--resume: checkpoint '" + path + "' cannot be opened");
     auto fail = [&](const std::string& m) -> void { throw InputError(path + ": " + m); };
-    std::string key, kind;
-    int version = 0, n = 0;
-    double t_max = 0;
-    SweepState s;
-    if (!(is >> key >> version) || key != "fibernet-sweep-checkpoint" || version != 1) fail("not a sweep checkpoint");
-    if (!(is >> key >> kind) || key != "kind") fail("missing kind");
-    if (kind != to_string(p.kind)) fail("strain kind '" + kind + "' differs from this run's '" + to_string(p.kind) + "'");
-    if (!(is >> key >> t_max) || key != "t_max") fail("missing t_max");
-    if (t_max != p.t_max) fail("gamma_max = " + show(t_max) + " differs from this run's " + show(p.t_max));
-    if (!(is >> key >> n) || key != "dofs") fail("missing dofs");
-    if (n != dofs) fail("dofs = " + std::to_string(n) + " differs from this model's " + std::to_string(dofs));
-    if (!(is >> key >> rows) || key != "rows") fail("missing rows");
+    std::string key, line;
+    int version = 0;
+    Checkpoint c;
+    SweepState& s = c.state;
+    if (!(is >> key >> version) || key != "fibernet-sweep-checkpoint") fail("not a sweep checkpoint");
+    if (version == 1)
+        fail("checkpoint version 1 does not record the sweep's parameters, so --resume cannot check them; remove it "
+             "(and the CSV) and run the sweep again");
+    if (version != 2) fail("checkpoint version " + std::to_string(version) + " is not supported (expected 2)");
+    if (!(is >> key) || key != "parameters" || !std::getline(is, line)) fail("missing parameters");
+    nlohmann::json recorded = nlohmann::json::parse(line, nullptr, false);
+    if (!recorded.is_object()) fail("parameters are not a JSON object");
+    for (auto it = params.begin(); it != params.end(); ++it) {
+        const nlohmann::json was = recorded.contains(it.key()) ? recorded[it.key()] : nlohmann::json();
+        if (was != it.value())
+            fail(it.key() + " = " + shown(was) + " differs from this run's " + shown(it.value()) + flag_of(it.key()));
+    }
+    for (auto it = recorded.begin(); it != recorded.end(); ++it)  // e.g. a network file against a generated network
+        if (!params.contains(it.key()))
+            fail(it.key() + " = " + shown(it.value()) + " is not a parameter of this run" + flag_of(it.key()));
+    if (!(is >> key >> c.dofs) || key != "dofs" || c.dofs < 0) fail("missing dofs");
+    if (!(is >> key >> c.rows) || key != "rows") fail("missing rows");
     if (!(is >> key >> s.step) || key != "step") fail("missing step");
     if (!(is >> key >> s.t) || key != "t") fail("missing t");
     if (!(is >> key >> s.next_step) || key != "next_step") fail("missing next_step");
     if (!(is >> key) || key != "q") fail("missing q");
-    s.q.resize(n);
-    for (int i = 0; i < n; ++i)
+    s.q.resize(c.dofs);
+    for (int i = 0; i < c.dofs; ++i)
         if (!(is >> s.q[i]) || !std::isfinite(s.q[i])) fail("q[" + std::to_string(i) + "] is missing or not finite");
-    return s;
+    return c;
 }
 
 // Keeps the header and the first `rows` data rows (a row written after the last checkpoint is dropped).
@@ -92,16 +144,30 @@ void register_sweep(CLI::App& app) {
     cmd->add_option("--step", p->step, "first step (default 0.01)");
     cmd->add_option("--min-step", p->min_step, "smallest step before giving up (default 1e-6)");
     cmd->add_option("--max-step", p->max_step, "largest step (default 0.05)");
-    cmd->add_option("-o,--output", *out, "CSV file, one row per accepted step")->required();
-    cmd->add_option("--checkpoint", *ckpt, "checkpoint file (default OUTPUT.ckpt)");
-    cmd->add_flag("--resume", *resume, "continue an interrupted sweep from its checkpoint");
+    cmd->add_option("-o,--output", *out, "CSV file, one row per accepted step (an existing one is replaced, unless --resume)")
+        ->required();
+    cmd->add_option("--checkpoint", *ckpt, "checkpoint file (default OUTPUT.ckpt); an existing one needs --resume");
+    cmd->add_flag("--resume", *resume, "continue an interrupted sweep from its checkpoint (same parameters only)");
     cmd->add_flag("-q,--quiet", *quiet, "no progress lines on stderr");
+    // A sweep's strain comes from --gamma-max: hide the scene flag --gamma (kept registered, so that giving it
+    // still gets the message below rather than CLI11's "not expected").
+    cmd->get_option("--gamma")->group("");
+    cmd->footer("Like `fibernet percolation --out`, an existing checkpoint is refused without --resume (its sweep "
+                "would be lost); without a checkpoint an existing CSV is replaced.");
     cmd->callback([=] {
         Scene s = flags->resolve();
         if (flags->given("--gamma")) throw InputError("command line: sweep takes --gamma-max, not --gamma");
         p->kind = s.strain;
         p->check("command line");
         if (ckpt->empty()) *ckpt = *out + ".ckpt";
+        check_outputs({{"-o", *out}, {"--checkpoint", *ckpt}});
+        std::error_code ec;
+        if (!*resume && std::filesystem::is_regular_file(*ckpt, ec))
+            throw InputError("command line: --checkpoint '" + *ckpt +
+                             "' exists (an earlier sweep); add --resume to continue it, or remove it");
+        const nlohmann::json params = sweep_parameters(s, *p);
+        Checkpoint c;
+        if (*resume) c = read_checkpoint(*ckpt, params);  // before any work: a mismatch costs nothing
         SolverOptions so;
         so.tol = s.solver.tol, so.max_iter = s.solver.max_iter;
         auto solver = make_solver(s.solver.name, so);
@@ -113,9 +179,12 @@ void register_sweep(CLI::App& app) {
         NetworkEnergy e(m);
 
         int rows = 0;
-        SweepState start;
+        const SweepState& start = c.state;
         if (*resume) {
-            start = read_checkpoint(*ckpt, *p, e.num_dofs(), rows);
+            if (c.dofs != e.num_dofs())
+                throw InputError(*ckpt + ": dofs = " + std::to_string(c.dofs) + " differs from this model's " +
+                                 std::to_string(e.num_dofs()));
+            rows = c.rows;
             truncate_csv(*out, rows);
             std::cerr << "sweep: resuming at step " << start.step << ", gamma = " << start.t << "\n";
         } else {
@@ -127,7 +196,7 @@ void register_sweep(CLI::App& app) {
         cb.stop = &g_stop;
         cb.on_step = [&](const SweepRow& r, const SweepState& st) {
             csv << csv_row(r) << '\n' << std::flush;
-            write_checkpoint(*ckpt, *p, ++rows, st);
+            write_checkpoint(*ckpt, params, ++rows, st);
             if (!*quiet)
                 std::cerr << "sweep: step " << r.step << "  gamma = " << r.t << "  s = " << r.stress_path
                           << "  K = " << r.K << "  iterations = " << r.iterations << "  retries = " << r.retries

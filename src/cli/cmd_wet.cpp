@@ -93,7 +93,7 @@ nlohmann::json free_box_json(const FreeBoxResult& f, const FreeBoxOptions& o) {
               {"bridges", f.bridges.size()},
               {"events",
                {{"moves", f.events.moves}, {"ruptures", f.events.ruptures}, {"formed", f.events.formed},
-                {"merged", f.events.merged}, {"locked", f.events.locked}}},
+                {"merged", f.events.merged}, {"locked", f.events.locked}, {"capped", f.events.capped}}},
               {"pores", pore_json(f.pores)},
               {"shear_modulus", num(f.shear_modulus)},
               {"shear_modulus_error", num(f.shear_modulus_error)},
@@ -120,6 +120,7 @@ void register_wet(CLI::App& app) {
         std::string free_box_shape;
         double free_box_tol = 0;
         double modulus_strain = 0;
+        int bundle_partners = 0;
     };
     auto w = std::make_shared<WetFlags>();
     auto* o_beta = cmd->add_option("--beta", w->beta, "adhesion per unit bundle length, bending units (default 1)");
@@ -127,7 +128,10 @@ void register_wet(CLI::App& app) {
     auto* o_law = cmd->add_option("--law", w->law, "tabulated capillary law file: lines 'alpha_deg value'");
     auto* o_cr = cmd->add_option("--crossings", w->crossings, "wet crossings: all | free | fraction (default all)");
     auto* o_fr = cmd->add_option("--fraction", w->fraction, "wet fraction of crossings, in [0, 1]");
-    auto* o_ws = cmd->add_option("--wet-seed", w->seed, "seed of the wet fraction draw");
+    auto* o_ws = cmd->add_option("--wet-seed", w->seed, "seed of the wet fraction draw")->check(seed_check());
+    auto* o_bp = cmd->add_option("--bundle-partners", w->bundle_partners,
+                                 "excluded volume: a segment adheres along at most N other fibers (0: no cap, the "
+                                 "default; 2: flat ribbon; 6: close-packed; docs/wet.md)");
     cmd->add_option("-o,--out-dir", w->out,
                     "write summary.json, sweep.csv, pores.csv, network.svg, pores.svg here (created if missing)");
     cmd->add_flag("--no-moduli", w->no_moduli, "skip the dry and wet shear moduli");
@@ -156,6 +160,7 @@ void register_wet(CLI::App& app) {
         if (o_fb->count()) s.wet.free_box = w->free_box;
         if (o_fbs->count()) s.wet.free_box_shape = w->free_box_shape;
         if (o_fbt->count()) s.wet.free_box_tol = w->free_box_tol;
+        if (o_bp->count()) s.wet.bundle_partners = w->bundle_partners;
         s.source = flags->scene_file.empty() ? "command line" : flags->scene_file + " + command line";
         s.check();
         std::vector<double> betas = w->betas.empty() ? std::vector<double>{s.wet.beta} : w->betas;
@@ -175,6 +180,7 @@ void register_wet(CLI::App& app) {
         opt.active_set.local_fraction = s.wet.local_fraction;
         opt.active_set.local_threshold = s.wet.local_threshold;
         opt.active_set.local_hops = s.wet.local_hops;
+        opt.active_set.bundle_partners = s.wet.bundle_partners;
         if (w->verbose && w->quiet) throw InputError("--verbose and --quiet contradict each other");
         opt.moduli = !w->no_moduli;
         if (o_ms->count()) {
@@ -228,7 +234,9 @@ void register_wet(CLI::App& app) {
                                  {{"law", s.wet.law.empty() ? "cos2" : s.wet.law},
                                   {"crossings", s.wet.crossings},
                                   {"fraction", s.wet.fraction},
-                                  {"free_box", s.wet.free_box}}},
+                                  {"free_box", s.wet.free_box},
+                                  {"bundle_partners", s.wet.bundle_partners}}},
+                                {"strain", to_string(s.strain)},
                                 {"gamma", s.gamma},
                                 {"runs", runs},
                                 {"complete", complete},
@@ -314,7 +322,7 @@ void register_wet(CLI::App& app) {
                  {"events",
                   {{"moves", r.active.events.moves}, {"ruptures", r.active.events.ruptures},
                    {"formed", r.active.events.formed}, {"merged", r.active.events.merged},
-                   {"locked", r.active.events.locked}, {"rounds", r.active.rounds}, {"cycling", r.active.cycling},
+                   {"locked", r.active.events.locked}, {"capped", r.active.events.capped}, {"rounds", r.active.rounds}, {"cycling", r.active.cycling},
                    {"cycles_broken", r.active.cycles_broken}, {"frozen_pairs", r.active.frozen_pairs},
                    {"local_rounds", r.active.local_rounds}, {"local_iterations", r.active.local_iterations}}},
                  {"bundles",

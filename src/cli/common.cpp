@@ -1,12 +1,88 @@
 #include "common.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <iostream>
 
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/util/error.hpp"
 
 namespace fibernet::cli {
+
+void Progress::start(const Network& net, const NetworkEnergy& e, const Scene& s) const {
+    if (!on_) return;
+    std::fprintf(stderr, "%s: %zu fibers, %d unknowns; equilibrium at %s gamma = %g (%s) ...\n", command_.c_str(),
+                 net.fibers.size(), e.num_dofs(), to_string(s.strain).c_str(), s.gamma, s.solver.name.c_str());
+}
+
+void Progress::solved(const SolveResult& r) const {
+    if (!on_) return;
+    std::fprintf(stderr, "%s: equilibrium %s after %d iterations (max|g| %.2e), %.2f s\n", command_.c_str(),
+                 to_string(r.status).c_str(), r.iterations, r.grad_max, r.timings.total);
+}
+
+void Progress::line(const std::string& what, const std::chrono::steady_clock::time_point& t0) const {
+    if (on_) std::fprintf(stderr, "%s: %s, %.2f s in all\n", command_.c_str(), what.c_str(), seconds_since(t0));
+}
+
+// Not an existing path of another kind (a device such as /dev/null is fine), a regular file that
+// can be opened for writing, a directory that lets us create the file (or the temporary renamed over it), and no
+// file named twice (the later write would destroy the earlier one; path.tmp is write_file_atomic's temporary).
+void check_outputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+    namespace fs = std::filesystem;
+    std::vector<std::pair<std::string, fs::path>> files;  // flag, absolute path of each regular (or new) file
+    for (const auto& [flag, path] : outputs) {
+        if (path.empty()) continue;
+        const std::string what = "command line: " + flag + " '" + path + "'";
+        struct stat st;
+        if (stat(path.c_str(), &st) == 0) {
+            if (S_ISDIR(st.st_mode)) throw InputError(what + " is a directory");
+            if (!S_ISREG(st.st_mode)) {
+                if (access(path.c_str(), W_OK) != 0) throw InputError(what + " cannot be written (" + std::strerror(errno) + ")");
+                continue;
+            }
+            const int fd = open(path.c_str(), O_WRONLY | O_CLOEXEC);  // no O_TRUNC: the file stays as it is
+            if (fd < 0) throw InputError(what + " cannot be opened for writing (" + std::strerror(errno) + ")");
+            close(fd);
+        }
+        std::error_code ec;
+        const fs::path abs = fs::weakly_canonical(fs::absolute(path), ec);
+        const fs::path p = ec ? fs::absolute(path).lexically_normal() : abs;
+        for (const auto& [other_flag, q] : files) {
+            if (p == q) throw InputError(what + " is also given as " + other_flag + ": give each output its own path");
+            if (p.string() == q.string() + ".tmp" || p.string() + ".tmp" == q.string())
+                throw InputError(what + " and " + other_flag + " are a file and its temporary '.tmp': give each "
+                                 "output its own path");
+        }
+        files.push_back({flag, p});
+        std::string probe = (p.parent_path() / ".fibernet-probe-XXXXXX").string();
+        const int fd = mkstemp(probe.data());
+        if (fd < 0)
+            throw InputError(what + ": cannot create a file in directory '" + p.parent_path().string() + "' (" +
+                             std::strerror(errno) + ")");
+        close(fd);
+        unlink(probe.c_str());
+    }
+}
+
+CLI::Validator seed_check() {
+    return CLI::Validator(
+        [](std::string& v) {
+            std::uint64_t x = 0;
+            const char* end = v.data() + v.size();
+            const auto r = std::from_chars(v.data(), end, x);
+            return r.ec == std::errc() && r.ptr == end ? std::string() : "seed " + v + " is not an integer in [0, 2^64)";
+        },
+        "SEED");
+}
 
 void SceneFlags::add(CLI::App* app, bool with_load) {
     opts.push_back(app->add_option("scene", scene_file, "scene file (TOML, see docs/formats.md); flags override it")
@@ -16,7 +92,7 @@ void SceneFlags::add(CLI::App* app, bool with_load) {
     opts.push_back(app->add_option("--L", L, "box side in fiber lengths (default 10)"));
     opts.push_back(app->add_option("--q", q, "density N lf^2 / A (default 8)"));
     opts.push_back(app->add_option("--pl", pl, "crosslink probability in [0, 1] (default 1)"));
-    opts.push_back(app->add_option("--seed", seed, "random seed (default 1)"));
+    opts.push_back(app->add_option("--seed", seed, "random seed, an integer in [0, 2^64) (default 1)")->check(seed_check()));
     opts.push_back(app->add_flag("--open", open, "open box instead of periodic"));
     opts.push_back(app->add_option("--scheme", scheme, "discretization: seed | even (default seed)"));
     opts.push_back(app->add_option("--nseg", n_seg, "seed scheme: segments per fiber (default 10)"));
@@ -70,6 +146,12 @@ Scene SceneFlags::resolve() const {
     set("--tol", s.solver.tol, tol);
     set("--max-iter", s.solver.max_iter, max_iter);
     if (flags) s.source = scene_file.empty() ? who : scene_file + " with command-line overrides";
+    // A saved network brings its own box and fibers: generation flags would be silently ignored.
+    if (!s.network_file.empty())
+        for (const char* g : {"--L", "--q", "--pl", "--seed", "--open"})
+            if (given(g))
+                throw InputError(std::string("command line: ") + g + " has no effect on a saved network ('" +
+                                 s.network_file + "' gives the box and the fibers); remove " + g);
     s.check();
     return s;
 }

@@ -6,10 +6,14 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "fibernet/energy/network_energy.hpp"
 #include "fibernet/model/model.hpp"
 #include "fibernet/network/network.hpp"
 #include "fibernet/scene/scene.hpp"
+#include "fibernet/solve/result.hpp"
 
 namespace fibernet::cli {
 
@@ -29,6 +33,26 @@ struct SceneFlags {
     bool given(const std::string& name) const;
     Scene resolve() const;  // scene file (or defaults) overridden by the flags given
 };
+
+// Progress lines on stderr for a one-shot command ("modulus: 96 fibers, 2480 DOF; ..."), off with --quiet.
+class Progress {
+public:
+    Progress(std::string command, bool on) : command_(std::move(command)), on_(on) {}
+    void start(const Network& net, const NetworkEnergy& e, const Scene& s) const;  // what is solved, and at what load
+    void solved(const SolveResult& r) const;                                       // the equilibrium's outcome
+    void line(const std::string& what, const std::chrono::steady_clock::time_point& t0) const;  // "<what>, 1.2 s"
+
+private:
+    std::string command_;
+    bool on_;
+};
+
+// Checks every output path (flag, path; empty paths skipped) before any work, so that bad input costs nothing and
+// leaves nothing: each must be writable and no file may be named twice. Throws InputError naming the flag.
+void check_outputs(const std::vector<std::pair<std::string, std::string>>& outputs);
+
+// A seed option's check: CLI11 wraps "-1" and saturates values past 2^64 - 1 into a uint64; digits in range only.
+CLI::Validator seed_check();
 
 // Commands whose physics acts on fiber end arms (bridges, clamps, rods) refuse `prune ends` with an InputError.
 void refuse_trimmed_ends(const Scene& s, const std::string& command, const std::string& why);

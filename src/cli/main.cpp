@@ -25,6 +25,16 @@ int main(int argc, char** argv) {
     cli::register_sweep(app);
     try {
         (void)thread_count();  // a bad FIBERNET_THREADS is an input error before any work
+        // CLI11 says only "A subcommand is required" for a word that names none: name it and the commands.
+        if (argc > 1 && argv[1][0] != '-') {
+            std::string names;
+            bool known = false;
+            for (const CLI::App* sub : app.get_subcommands({})) {
+                names += (names.empty() ? "" : ", ") + sub->get_name();
+                known = known || sub->check_name(argv[1]);
+            }
+            if (!known) throw InputError(std::string("unknown command '") + argv[1] + "' (expected one of: " + names + ")");
+        }
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);

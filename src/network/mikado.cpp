@@ -77,8 +77,11 @@ std::vector<Crossing> find_crossings(const Network& net) {
     if (!net.periodic)
         for (const auto& c : centre) lo = lo.cwiseMin(c), hi = hi.cwiseMax(c);
     const Eigen::Vector2d ext = hi - lo;
-    const int nx = std::max(1, static_cast<int>(std::floor(ext.x() / lmax)));
-    const int ny = std::max(1, static_cast<int>(std::floor(ext.y() / lmax)));
+    // At most about 4 cells per fiber: a sparse network in a huge box would otherwise allocate (L / lmax)^2 cells
+    // (1e12 at L = 1e6). Fewer, larger cells stay correct (side >= lmax).
+    const double most = std::max(1.0, std::floor(std::sqrt(4.0 * n)));
+    const int nx = static_cast<int>(std::max(1.0, std::min(most, std::floor(ext.x() / lmax))));
+    const int ny = static_cast<int>(std::max(1.0, std::min(most, std::floor(ext.y() / lmax))));
     auto cell_of = [&](const Eigen::Vector2d& c, int& cx, int& cy) {
         Eigen::Vector2d r = c - lo;
         if (net.periodic) r = r - net.L * (r / net.L).array().floor().matrix();

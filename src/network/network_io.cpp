@@ -1,8 +1,10 @@
 #include "fibernet/network/network_io.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <sys/stat.h>
 
@@ -144,6 +146,8 @@ Network read_network(std::istream& is, const std::string& source) {
         const long nc = r.integer(cs, "crossing count", 0, 1000000000);
         r.expect_end(cs);
         net.crossings.resize(nc);
+        // Two straight fibers cross at most once per periodic image: a repeated line would count twice.
+        std::map<std::array<int, 4>, long> seen;
         for (long k = 0; k < nc; ++k) {
             auto ls = r.next("crossing " + std::to_string(k));
             Crossing& c = net.crossings[k];
@@ -168,6 +172,12 @@ Network read_network(std::istream& is, const std::string& source) {
             if ((p1 - p2).norm() > 1e-8 * std::max(1.0, net.L))
                 r.fail("crossing " + std::to_string(k) + " points on fibers " + std::to_string(c.f1) + " and " +
                        std::to_string(c.f2) + " are " + show((p1 - p2).norm()) + " apart (must coincide)");
+            const std::array<int, 4> key = c.f1 < c.f2 ? std::array<int, 4>{c.f1, c.f2, c.image.x(), c.image.y()}
+                                                       : std::array<int, 4>{c.f2, c.f1, -c.image.x(), -c.image.y()};
+            const auto [it, fresh] = seen.emplace(key, k);
+            if (!fresh)
+                r.fail("crossing " + std::to_string(k) + " repeats crossing " + std::to_string(it->second) +
+                       " (fibers " + std::to_string(key[0]) + " and " + std::to_string(key[1]) + ")");
         }
     }
     std::string rest;

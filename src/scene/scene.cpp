@@ -1,6 +1,8 @@
 #include "fibernet/scene/scene.hpp"
 
+#include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <toml++/toml.h>
@@ -15,12 +17,19 @@ void Scene::check() const {
     if (network_file.empty()) mikado.check(source);
     discretization.check(source);
     check_value(true, gamma, source, "gamma", "");
+    // F = I + gamma dF must keep the box's orientation (uniaxial and isotropic paths: gamma > -1); a mirrored or
+    // collapsed box has no physical meaning, and its relaxation would be reported as if it had.
+    check_value(deformation(strain, gamma).determinant() > 0, gamma, source, "gamma",
+                "gives det F <= 0 on the " + to_string(strain) + " path (the box flips or collapses; need gamma > -1)");
     check_value(solver.tol > 0, solver.tol, source, "solver.tol", "must be > 0");
     check_value(solver.max_iter >= 1, solver.max_iter, source, "solver.max_iter", "must be >= 1");
     check_value(wet.beta >= 0, wet.beta, source, "[wet].beta", "must be >= 0");
     check_value(wet.fraction >= 0 && wet.fraction <= 1, wet.fraction, source, "[wet].fraction", "must lie in [0, 1]");
     if (wet.crossings != "all" && wet.crossings != "free" && wet.crossings != "fraction")
         throw InputError(source + ": [wet].crossings = '" + wet.crossings + "' is unknown (expected all, free or fraction)");
+    if (wet.crossings != "fraction" && wet.fraction != 1)  // else silently ignored, yet reported in the summary
+        throw InputError(source + ": [wet].fraction = " + show(wet.fraction) + " is used only with crossings = "
+                         "fraction (crossings is '" + wet.crossings + "')");
     check_value(wet.free_box_tol > 0, wet.free_box_tol, source, "[wet].free_box_tol", "must be > 0");
     check_value(wet.max_rounds >= 1, wet.max_rounds, source, "[wet].max_rounds", "must be >= 1");
     check_value(wet.round_iterations >= 0, wet.round_iterations, source, "[wet].round_iterations", "must be >= 0");
@@ -29,6 +38,7 @@ void Scene::check() const {
     check_value(wet.local_threshold > 0 && wet.local_threshold < 1, wet.local_threshold, source, "[wet].local_threshold",
                 "must lie in (0, 1)");
     check_value(wet.local_hops >= 0, wet.local_hops, source, "[wet].local_hops", "must be >= 0");
+    check_value(wet.bundle_partners >= 0, wet.bundle_partners, source, "[wet].bundle_partners", "must be >= 0 (0: no cap)");
     if (wet.free_box_shape != "full" && wet.free_box_shape != "isotropic")
         throw InputError(source + ": [wet].free_box_shape = '" + wet.free_box_shape +
                          "' is unknown (expected isotropic or full)");
@@ -71,7 +81,16 @@ struct TableReader {
         } else if constexpr (std::is_same_v<T, std::string>) {
             if (auto v = n->value_exact<std::string>()) return out = *v, true;
         } else {
-            if (auto v = n->value_exact<int64_t>()) return out = static_cast<T>(*v), true;
+            if (auto v = n->value_exact<int64_t>()) {
+                // A TOML integer outside T's range would wrap silently (max_iter = 2^32 + 2 ran 2 iterations).
+                if (*v < static_cast<int64_t>(std::numeric_limits<T>::min()) ||
+                    (std::numeric_limits<T>::max() < std::numeric_limits<int64_t>::max() &&
+                     *v > static_cast<int64_t>(std::numeric_limits<T>::max())))
+                    throw InputError(where + "." + key + " = " + std::to_string(*v) + " is out of range [" +
+                                     std::to_string(std::numeric_limits<T>::min()) + ", " +
+                                     std::to_string(std::numeric_limits<T>::max()) + "]");
+                return out = static_cast<T>(*v), true;
+            }
         }
         throw InputError(where + "." + key + " has the wrong type (" + type_name(n->type()) + ")");
     }
@@ -105,7 +124,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     for (const auto& [k, v] : root) {
         if (!tables.count(std::string(k.str())) || !v.is_table())
             throw InputError(source + ": unknown table or key '" + std::string(k.str()) +
-                             "' (expected [network], [model], [load], [solver])");
+                             "' (expected [network], [model], [load], [solver], [wet])");
     }
     auto table = [&](const char* name) -> const toml::table& {
         static const toml::table empty;
@@ -114,12 +133,17 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     };
     {
         TableReader r{table("network"), source + ": [network]"};
+        std::vector<std::string> generation;  // generation keys given (they have no effect with a file)
+        for (const char* k : {"L", "q", "pl", "seed", "periodic"})
+            if (r.t.get(k)) generation.push_back(k);
         r.get("L", s.mikado.L);
         r.get("q", s.mikado.q);
         r.get("pl", s.mikado.pl);
         r.get_seed("seed", s.mikado.seed);
         r.get("periodic", s.mikado.periodic);
-        r.get("file", s.network_file);
+        if (r.get("file", s.network_file) && !generation.empty())
+            throw InputError(source + ": [network].file = '" + s.network_file + "' is given with [network]." +
+                             generation.front() + ": a saved network brings its own box and fibers (remove one)");
         r.finish();
     }
     {
@@ -186,6 +210,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         r.get("local_fraction", s.wet.local_fraction);
         r.get("local_threshold", s.wet.local_threshold);
         r.get("local_hops", s.wet.local_hops);
+        r.get("bundle_partners", s.wet.bundle_partners);
         r.finish();
     }
     s.check();
@@ -197,7 +222,13 @@ Scene load_scene(const std::string& path) {
     if (!is) throw InputError("scene file '" + path + "' cannot be opened");
     std::stringstream ss;
     ss << is.rdbuf();
-    return parse_scene(ss.str(), path);
+    Scene s = parse_scene(ss.str(), path);
+    // A network file named in a scene is found next to the scene, wherever it is run from.
+    if (!s.network_file.empty() && std::filesystem::path(s.network_file).is_relative())
+        s.network_file = (std::filesystem::path(path).parent_path() / s.network_file).lexically_normal().string();
+    if (!s.network_file.empty() && !std::filesystem::is_regular_file(s.network_file))
+        throw InputError(path + ": [network].file = '" + s.network_file + "' is not a readable file");
+    return s;
 }
 
 Network scene_network(const Scene& s) {

@@ -12,6 +12,7 @@
 #include <memory>
 #include <mutex>
 #include <numeric>
+#include <unordered_map>
 #include <set>
 #include <utility>
 
@@ -366,6 +367,48 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
     for (const Bridge& b : bridges)
         if (std::binary_search(pairs.begin(), pairs.end(), std::make_pair(std::min(b.f1, b.f2), std::max(b.f1, b.f2))))
             note(b);
+    // Excluded volume (ActiveSetOptions::bundle_partners): the other fibers each candidate segment already lies along
+    // (its aligned bridges), so that a new aligned bridge can be refused where a segment has its share. Only the
+    // candidates' segments are indexed.
+    const int cap = opt.bundle_partners;
+    auto seg_of = [&](int f, int k) { return m.chains[f].segments[k]; };
+    auto aligned = [&](int s1, int s2) {
+        return std::abs(cross2(geom.D[s1], geom.D[s2])) <= sin_c * geom.D[s1].norm() * geom.D[s2].norm();
+    };
+    std::unordered_map<int, std::vector<int>> along;  // segment -> fibers it holds aligned bridges with
+    auto add_partner = [&](int s, int f) {
+        std::vector<int>& v = along[s];
+        if (std::find(v.begin(), v.end(), f) == v.end()) v.push_back(f);
+    };
+    if (cap > 0) {
+        std::vector<int> cand;
+        for (const auto* list : {&crossings, &contacts})
+            for (const Bridge& c : *list)
+                cand.push_back(seg_of(c.f1, c.k1)), cand.push_back(seg_of(c.f2, c.k2));
+        std::sort(cand.begin(), cand.end());
+        cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+        auto is_cand = [&](int s) { return std::binary_search(cand.begin(), cand.end(), s); };
+        for (const Bridge& b : bridges) {
+            const int s1 = seg_of(b.f1, b.k1), s2 = seg_of(b.f2, b.k2);
+            const bool c1 = is_cand(s1), c2 = is_cand(s2);
+            if ((!c1 && !c2) || (!b.locked && !aligned(s1, s2))) continue;
+            if (c1) add_partner(s1, b.f2);
+            if (c2) add_partner(s2, b.f1);
+        }
+    }
+    // True if the new bridge c may form; an aligned one is then counted on both its segments.
+    auto admit = [&](const Bridge& c, bool contact) {
+        const int s1 = seg_of(c.f1, c.k1), s2 = seg_of(c.f2, c.k2);
+        if (cap <= 0 || (!contact && !aligned(s1, s2))) return true;
+        auto full = [&](int s, int other) {
+            const auto it = along.find(s);
+            if (it == along.end()) return false;
+            return static_cast<int>(it->second.size() - std::count(it->second.begin(), it->second.end(), other)) >= cap;
+        };
+        if (full(s1, c.f2) || full(s2, c.f1)) return false;
+        add_partner(s1, c.f2), add_partner(s2, c.f1);
+        return true;
+    };
     for (const Bridge& c : crossings) {
         auto& v = near[{c.f1, c.f2, c.image.x(), c.image.y()}];
         const bool known = std::any_of(v.begin(), v.end(), [&](const std::pair<int, int>& h) {
@@ -386,12 +429,20 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
             }
             if (near_end) continue;
         }
+        if (!admit(c, false)) {
+            ++ev.capped;
+            continue;
+        }
         note(c);
         bridges.push_back(c);
         ++ev.formed;
     }
     for (const Bridge& c : contacts) {
         if (partnered.count({c.f1, c.k1, c.f2}) || partnered.count({c.f2, c.k2, c.f1}) || is_frozen(c.f1, c.f2)) continue;
+        if (!admit(c, true)) {
+            ++ev.capped;
+            continue;
+        }
         note(c);
         bridges.push_back(c);
         ++ev.formed;
@@ -560,6 +611,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         r.seconds_update += now() - t0;
         r.events.moves += ev.moves, r.events.ruptures += ev.ruptures;
         r.events.formed += ev.formed, r.events.merged += ev.merged, r.events.locked += ev.locked;
+        r.events.capped += ev.capped;
         // Moves, locks and fade-out ruptures leave the energy unchanged near q: if the updated set's gradient at q is
         // no larger than the one the solver accepted, q is already an equilibrium of it (and beta = 0 stays bit for
         // bit the dry result). After a local round this is the whole network's gradient against the region's
@@ -624,13 +676,14 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         if (opt.verbose)
             std::fprintf(stderr,
                          "wet round %2d: %s%s in %d iterations (max|g| %.2e), %zu bridges after moves %d, ruptures %d, "
-                         "formed %d, merged %d, locked %d\n",
+                         "formed %d, merged %d, locked %d%s\n",
                          round,
                          local ? ("local (" + std::to_string(region_size) + " coordinates in " +
                                   std::to_string(region_parts_n) + " pieces) ").c_str()
                                : "",
                          to_string(r.last.status).c_str(), r.last.iterations, use_local ? gmax : r.last.grad_max,
-                         bridges.size(), ev.moves, ev.ruptures, ev.formed, ev.merged, ev.locked);
+                         bridges.size(), ev.moves, ev.ruptures, ev.formed, ev.merged, ev.locked,
+                         opt.bundle_partners > 0 ? (", capped " + std::to_string(ev.capped)).c_str() : "");
         if (equilibrium) {
             r.stable = true;
             r.message = "stable after " + std::to_string(round) + " round(s)" +

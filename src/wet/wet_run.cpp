@@ -307,7 +307,7 @@ public:
 
     void add_events(const WetEvents& e) {
         R_.events.moves += e.moves, R_.events.ruptures += e.ruptures, R_.events.formed += e.formed;
-        R_.events.merged += e.merged, R_.events.locked += e.locked;
+        R_.events.merged += e.merged, R_.events.locked += e.locked, R_.events.capped += e.capped;
     }
 
 private:

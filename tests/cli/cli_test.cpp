@@ -42,6 +42,10 @@ TEST_CASE("cli: bad input exits 2, names the value and writes no output file", "
         {"generate --frobnicate", "frobnicate"},
         {"generate --q abc", "abc"},
         {"export --network /nonexistent.net", "nonexistent"},
+        {"nosuchcmd", "unknown command 'nosuchcmd' (expected one of: generate,"},
+        {"generate --seed -1", "seed -1 is not an integer in [0, 2^64)"},
+        {"generate --seed 18446744073709551616", "seed 18446744073709551616 is not an integer"},
+        {"relax --L 3 --q 5 --strain uniaxial --gamma -2", "gamma = -2 gives det F <= 0"},
     };
     for (const auto& c : cases) {
         std::remove(out.c_str());
@@ -56,6 +60,14 @@ TEST_CASE("cli: bad input exits 2, names the value and writes no output file", "
     CHECK(run("export --network " + bad + " -o " + out) == 2);
     CHECK(slurp(tmpdir() + "/stderr").find(bad + ":4: fiber theta = 'zero' is not a number") != std::string::npos);
     CHECK(!exists(out));
+    // Generation flags beside a saved network would be ignored silently.
+    REQUIRE(run("generate --L 3 --q 5 -o " + tmpdir() + "/saved.net") == 0);
+    for (const char* flag : {"--pl 0.2", "--L 9", "--q 3", "--seed 5", "--open"}) {
+        INFO(flag);
+        CHECK(run("export --network " + tmpdir() + "/saved.net " + flag + " -o " + out) == 2);
+        CHECK(slurp(tmpdir() + "/stderr").find("has no effect on a saved network") != std::string::npos);
+        CHECK(!exists(out));
+    }
     // A malformed scene.
     const std::string scene = tmpdir() + "/bad.toml";
     std::ofstream(scene) << "[network]\npl = -0.1\n";

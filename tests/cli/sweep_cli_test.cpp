@@ -29,3 +29,74 @@ TEST_CASE("cli sweep: bad input exits 2 and writes nothing", "[cli][sweep][input
         CHECK(!exists(csv));
     }
 }
+
+TEST_CASE("cli sweep: outputs are checked before the first row", "[cli][sweep][input]") {
+    const std::string csv = tmpdir() + "/sweep_paths.csv";
+    const std::string net = "sweep --L 3 --q 7 --seed 4 --scheme even --h 2.5 --gamma-max 0.02 -q";
+    // A checkpoint in a missing directory: refused before the CSV gets its header and first row.
+    CHECK(run(net + " -o " + csv + " --checkpoint " + tmpdir() + "/nodir/c.ckpt") == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("--checkpoint '" + tmpdir() + "/nodir/c.ckpt'") != std::string::npos);
+    CHECK(!exists(csv));
+    // One file for both outputs: the checkpoint would overwrite the CSV.
+    CHECK(run(net + " -o " + csv + " --checkpoint " + tmpdir() + "/./sweep_paths.csv") == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("also given as -o") != std::string::npos);
+    CHECK(!exists(csv));
+    CHECK(run(net + " -o " + tmpdir()) == 2);  // a directory
+    CHECK(slurp(tmpdir() + "/stderr").find("is a directory") != std::string::npos);
+}
+
+TEST_CASE("cli sweep: --resume refuses a checkpoint of other parameters, naming them", "[cli][sweep][input]") {
+    const std::string csv = tmpdir() + "/sweep_resume.csv";
+    const std::string net = "sweep --L 3 --q 7 --scheme even --h 2.5 --gamma-max 0.02 --step 0.01 -q ";
+    REQUIRE(run(net + "--seed 4 --a 10 -o " + csv) == 0);
+    const std::string rows = slurp(csv), ckpt = slurp(csv + ".ckpt");
+    struct Case {
+        std::string args, message;
+    };
+    const Case cases[] = {
+        {"--seed 4 --a 20", "a = 10.0 differs from this run's 20.0 (--a)"},
+        {"--seed 4 --a 10 --tol 1e-6", "tol = 1e-10 differs from this run's 1e-06 (--tol)"},
+        {"--seed 5 --a 10", "seed = 4 differs from this run's 5 (--seed)"},
+        {"--seed 4 --a 10 --max-step 0.02", "max_step = 0.05 differs from this run's 0.02 (--max-step)"},
+        {"--seed 4 --a 10 --solver lbfgs", "solver = newton differs from this run's lbfgs (--solver)"},
+        {"--seed 4 --a 10 --open", "periodic = true differs from this run's false (--open)"},
+    };
+    for (const auto& c : cases) {
+        INFO(c.args);
+        CHECK(run(net + c.args + " --resume -o " + csv) == 2);
+        CHECK(slurp(tmpdir() + "/stderr").find(csv + ".ckpt: " + c.message) != std::string::npos);
+        CHECK(slurp(csv) == rows);
+        CHECK(slurp(csv + ".ckpt") == ckpt);
+    }
+    REQUIRE(run(net + "--seed 4 --a 10 --resume -o " + csv) == 0);  // the same parameters: nothing left to do
+    CHECK(slurp(csv) == rows);
+    // A checkpoint of the first format records no parameters: refused, not trusted.
+    write(csv + ".ckpt", "fibernet-sweep-checkpoint 1\nkind shear\nt_max 0.02\ndofs 0\nrows 0\nstep 0\nt 0\n"
+                         "next_step 0.01\nq\n");
+    CHECK(run(net + "--seed 4 --a 10 --resume -o " + csv) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("version 1 does not record") != std::string::npos);
+}
+
+TEST_CASE("cli sweep: an existing checkpoint needs --resume; a CSV alone is replaced", "[cli][sweep][input]") {
+    const std::string csv = tmpdir() + "/sweep_exists.csv";
+    const std::string net = "sweep --L 3 --q 7 --seed 4 --scheme even --h 2.5 --gamma-max 0.02 --step 0.01 -q -o ";
+    write(csv, "not a sweep\n");
+    REQUIRE(run(net + csv) == 0);  // no checkpoint: the CSV is replaced
+    CHECK(slurp(csv).rfind("step,gamma,", 0) == 0);
+    const std::string rows = slurp(csv);
+    CHECK(run(net + csv) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("add --resume to continue it, or remove it") != std::string::npos);
+    CHECK(slurp(csv) == rows);
+    CHECK(run("sweep --help") == 0);
+    CHECK(slurp(tmpdir() + "/stdout").find("replaced") != std::string::npos);
+}
+
+TEST_CASE("cli sweep: --help does not offer --gamma, which sweep refuses", "[cli][sweep][input]") {
+    REQUIRE(run("sweep --help") == 0);
+    const std::string help = slurp(tmpdir() + "/stdout");
+    CHECK(help.find("--gamma-max") != std::string::npos);
+    CHECK(help.find("--gamma ") == std::string::npos);
+    CHECK(run("sweep --L 3 --q 7 --gamma-max 0.02 --gamma 0.01 -q -o " + tmpdir() + "/sweep_gamma.csv") == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("sweep takes --gamma-max, not --gamma") != std::string::npos);
+    CHECK(!exists(tmpdir() + "/sweep_gamma.csv"));
+}

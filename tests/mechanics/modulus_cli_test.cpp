@@ -52,6 +52,34 @@ TEST_CASE("cli modulus: the default scene converges", "[cli][modulus]") {
     REQUIRE(run(std::string(FIBERNET_SOURCE_DIR) + "/problems/default.toml") == 2);  // a scene alone is no command
     REQUIRE(run("modulus " + std::string(FIBERNET_SOURCE_DIR) + "/problems/default.toml") == 0);
     CHECK(out()["moduli"]["G"].get<double>() > 0);
+    // Progress on stderr: what is solved, the equilibrium's outcome, the end; none with -q.
+    const std::string err = slurp(dir() + "/stderr");
+    CHECK(err.find("modulus: 800 fibers, ") != std::string::npos);
+    CHECK(err.find("modulus: equilibrium converged after") != std::string::npos);
+    CHECK(err.find("modulus: done, ") != std::string::npos);
+    REQUIRE(run("modulus -q " + std::string(FIBERNET_SOURCE_DIR) + "/problems/default.toml") == 0);
+    CHECK(slurp(dir() + "/stderr").empty());
+    CHECK(run("modulus -q -v --L 3 --q 8") == 2);
+}
+
+TEST_CASE("cli relax: an output path that cannot be written is refused before the solve", "[cli][modulus][input]") {
+    const std::string d = dir() + "/relax_out";
+    REQUIRE(std::system(("rm -rf " + d + " && mkdir -p " + d).c_str()) == 0);
+    struct Case {
+        std::string path, needle;
+    };
+    for (const Case& c : {Case{d + "/missing/model.txt", "cannot create a file"}, Case{d, "is a directory"}}) {
+        INFO(c.path);
+        CHECK(run("relax --L 3 --q 8 -o " + c.path) == 2);
+        const std::string err = slurp(dir() + "/stderr");
+        CHECK(err.find("--output '" + c.path + "'") != std::string::npos);
+        CHECK(err.find(c.needle) != std::string::npos);
+        CHECK(err.find("relax: ") == std::string::npos);  // refused before any progress line (no solve)
+        CHECK(slurp(dir() + "/stdout").empty());
+    }
+    CHECK(std::system(("test -z \"$(ls -A " + d + ")\"").c_str()) == 0);  // no probe or partial file left
+    REQUIRE(run("relax --L 3 --q 8 -o " + d + "/model.txt") == 0);
+    CHECK(slurp(dir() + "/stderr").find("relax: done, ") != std::string::npos);
 }
 
 TEST_CASE("cli modulus: a solver that does not converge exits 1 and prints no modulus", "[cli][modulus]") {

@@ -138,4 +138,12 @@ TEST_CASE("sweep: bad parameters name the value", "[mechanics][sweep][input]") {
     p = {};
     p.min_step = 1;
     CHECK_THROWS_AS(p.check("cli"), InputError);
+    // A compression that flips or collapses the box; shear has det F = 1 at any strain.
+    p = {};
+    p.kind = StrainKind::Isotropic, p.t_max = -1;
+    CHECK_THROWS_WITH(p.check("cli"), Catch::Contains("gamma_max = -1 gives det F <= 0 on the isotropic path"));
+    p.kind = StrainKind::UniaxialY, p.t_max = -1.5;
+    CHECK_THROWS_WITH(p.check("cli"), Catch::Contains("gamma_max = -1.5 gives det F <= 0"));
+    p.kind = StrainKind::Shear;
+    CHECK_NOTHROW(p.check("cli"));
 }

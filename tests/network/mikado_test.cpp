@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "fibernet/network/mikado.hpp"
+#include "fibernet/network/network_io.hpp"
 #include "fibernet/util/error.hpp"
 #include "fibernet/util/random.hpp"
 
@@ -35,12 +36,38 @@ TEST_CASE("mikado: a seed gives the same network every time, and the values are 
     CHECK(generate_mikado(p).fibers[0].theta != a.fibers[0].theta);
 }
 
+TEST_CASE("mikado: the generator reproduces the committed reference network", "[network][random]") {
+    // data/mikado_L10_q8_pl0.5_seed1.net was written by `fibernet generate --L 10 --q 8 --pl 0.5 --seed 1`: the same
+    // seed must give the same network on any platform and standard library (no std:: distributions). Orientations and
+    // crosslink draws are exact functions of the stream; positions go through cos/sin (to 1e-13).
+    const Network ref = load_network(std::string(FIBERNET_SOURCE_DIR) + "/data/mikado_L10_q8_pl0.5_seed1.net");
+    MikadoParams p;
+    p.L = 10, p.q = 8, p.pl = 0.5, p.seed = 1;
+    const Network net = generate_mikado(p);
+    REQUIRE(net.fibers.size() == ref.fibers.size());
+    for (size_t i = 0; i < net.fibers.size(); ++i) {
+        INFO("fiber " << i);
+        CHECK(net.fibers[i].theta == ref.fibers[i].theta);
+        CHECK((net.fibers[i].start - ref.fibers[i].start).norm() <= 1e-13 * p.L);
+    }
+    REQUIRE(net.crossings.size() == ref.crossings.size());
+    int mismatched = 0;
+    for (size_t k = 0; k < net.crossings.size(); ++k) {
+        const Crossing &a = net.crossings[k], &b = ref.crossings[k];
+        mismatched += a.f1 != b.f1 || a.f2 != b.f2 || a.image != b.image || a.crosslink != b.crosslink ||
+                      std::abs(a.s1 - b.s1) > 1e-12 || std::abs(a.s2 - b.s2) > 1e-12;
+    }
+    CHECK(mismatched == 0);
+}
+
 TEST_CASE("mikado: the cell list finds exactly the crossings of a brute-force search", "[network]") {
+    // q = 0.05 at L = 60: a sparse network in a large box, where the cell grid is capped at about 4 cells per fiber
+    // (not (L / lf)^2 cells).
     for (bool periodic : {true, false})
-        for (double L : {2.2, 2.9, 3.5, 5.0})
+        for (double L : {2.2, 2.9, 3.5, 5.0, 60.0})
             for (std::uint64_t seed : {1, 2, 3}) {
                 MikadoParams p;
-                p.L = L, p.q = 7, p.pl = 1, p.seed = seed, p.periodic = periodic;
+                p.L = L, p.q = L > 10 ? 0.05 : 7, p.pl = 1, p.seed = seed, p.periodic = periodic;
                 const Network net = generate_mikado(p);
                 const auto fast = net.crossings;
                 const auto slow = find_crossings_brute_force(net);

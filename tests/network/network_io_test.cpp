@@ -65,5 +65,8 @@ TEST_CASE("network io: malformed files are rejected with file, line and value", 
     expect_error(replace(valid(), "0 1 0.5 0.5 0 0 1", "0 1 0.4 0.5 0 0 1"), "apart (must coincide)");
     expect_error(replace(valid(), "0 1 0.5 0.5 0 0 1", "0 1 0.5 0.5 0 0 1 7"), "unexpected extra field");
     expect_error(valid() + "junk\n", "unexpected content");
+    // A repeated crossing (either fiber order) would count twice.
+    expect_error(replace(valid(), "crossings 1\n0 1 0.5 0.5 0 0 1\n", "crossings 2\n0 1 0.5 0.5 0 0 1\n1 0 0.5 0.5 0 0 1\n"),
+                 "net.txt:8: crossing 1 repeats crossing 0 (fibers 0 and 1)");
     CHECK_THROWS_AS(load_network("/nonexistent/file.txt"), InputError);
 }

@@ -1,5 +1,8 @@
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+#include <fstream>
+
 #include "fibernet/scene/scene.hpp"
 #include "fibernet/util/error.hpp"
 
@@ -39,4 +42,27 @@ TEST_CASE("scene: bad scenes name the file, key and value", "[scene][input]") {
     CHECK_THROWS_WITH(parse_scene("[network\n", "s.toml"), Catch::Contains("s.toml:1"));
     CHECK_THROWS_WITH(parse_scene("[network]\nseed = -4\n", "s.toml"), Catch::Contains("[network].seed = -4 must be >= 0"));
     CHECK_THROWS_AS(load_scene("/nonexistent.toml"), InputError);
+    // Integers out of range would wrap (max_iter = 2^32 + 2 ran 2 iterations).
+    CHECK_THROWS_WITH(parse_scene("[solver]\nmax_iter = 4294967298\n", "s.toml"),
+                      Catch::Contains("[solver].max_iter = 4294967298 is out of range"));
+    // A box that flips or collapses (det F <= 0) is not a load; shear keeps det F = 1 at any gamma.
+    CHECK_THROWS_WITH(parse_scene("[load]\nstrain = \"uniaxial\"\ngamma = -2\n", "s.toml"),
+                      Catch::Contains("gamma = -2 gives det F <= 0 on the uniaxial path"));
+    CHECK_THROWS_WITH(parse_scene("[load]\nstrain = \"isotropic\"\ngamma = -1\n", "s.toml"),
+                      Catch::Contains("gamma = -1 gives det F <= 0"));
+    CHECK(parse_scene("[load]\nstrain = \"shear\"\ngamma = -2\n", "s.toml").gamma == -2);
+    // A saved network brings its own box: generation keys beside it would be ignored.
+    CHECK_THROWS_WITH(parse_scene("[network]\nfile = \"n.txt\"\npl = 0.2\n", "s.toml"),
+                      Catch::Contains("[network].file = 'n.txt' is given with [network].pl"));
+}
+
+TEST_CASE("scene: a network file is found next to its scene and must exist", "[scene][input]") {
+    const std::string dir = "/tmp/fibernet_scene_test_dir";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "/net.txt") << "fibernet-network 1\nbox 10 open\nfibers 1\n0 0 0 1\ncrossings 0\n";
+    std::ofstream(dir + "/ok.toml") << "[network]\nfile = \"net.txt\"\n";
+    std::ofstream(dir + "/missing.toml") << "[network]\nfile = \"gone.txt\"\n";
+    CHECK(load_scene(dir + "/ok.toml").network_file == dir + "/net.txt");
+    CHECK_THROWS_WITH(load_scene(dir + "/missing.toml"),
+                      Catch::Contains("missing.toml: [network].file = '" + dir + "/gone.txt' is not a readable file"));
 }

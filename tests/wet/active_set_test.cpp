@@ -1,7 +1,10 @@
 // Mobility and events (issue 6, part 2): bridges follow their crossing across nodes without an energy jump, rupture
 // continuously off a fiber end, form at new crossings and contacts; the outer loop terminates and reports.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <set>
 
 #include "fibernet/wet/active_set.hpp"
 #include "fibernet/wet/wet_energy.hpp"
@@ -229,6 +232,67 @@ TEST_CASE("active set: zipped fibers hold one bridge per segment pair, adhesion 
             CHECK(ev.formed == static_cast<int>(bridges.size()));
             CHECK(std::abs(E / (-p.beta * overlap) - 1) < 0.05);
         }
+}
+
+namespace {
+// The most other fibers any one segment holds bridges with.
+int max_partners(const std::vector<Bridge>& bridges) {
+    std::map<std::pair<int, int>, std::set<int>> along;
+    for (const Bridge& b : bridges) along[{b.f1, b.k1}].insert(b.f2), along[{b.f2, b.k2}].insert(b.f1);
+    size_t most = 0;
+    for (const auto& [seg, fibers] : along) most = std::max(most, fibers.size());
+    return static_cast<int>(most);
+}
+int bridges_with(const std::vector<Bridge>& bridges, int f) {
+    return static_cast<int>(std::count_if(bridges.begin(), bridges.end(), [&](const Bridge& b) { return b.f1 == f || b.f2 == f; }));
+}
+}  // namespace
+
+TEST_CASE("active set: the bundle-partner cap bounds how many fibers a segment adheres along", "[wet][bundle]") {
+    // Four parallel fibers 0.05 seed units apart (all within the fiber diameter 0.2 of each other), shifted along x
+    // so no two ends coincide: without a cap every segment zips with all three others (2D stacking).
+    std::vector<Line> stack;
+    for (int i = 0; i < 4; ++i) stack.push_back({1.5 + 0.03 * i, 1.5 + 0.005 * i, 0, 1, 0.5});
+    // The bridges that form on `lines`; with `late` the last fiber first lies 5 seed units away and arrives after
+    // the others have zipped.
+    auto run = [&](const std::vector<Line>& lines, int cap, WetEvents* events = nullptr, bool late = false) {
+        const Network net = network_of(lines, 3);
+        const Model m = model_of(net);
+        NetworkEnergy e(m);
+        std::vector<Bridge> bridges;
+        ActiveSetOptions opt;
+        opt.bundle_partners = cap;
+        const Eigen::VectorXd q = e.dofs(m.x);
+        if (late) update_bridges(e, moved(e, q, static_cast<int>(lines.size()) - 1, 0, 5), I2, bridges, opt);
+        const WetEvents ev = update_bridges(e, q, I2, bridges, opt);
+        if (events) *events = ev;
+        return bridges;
+    };
+    WetEvents ev;
+    const std::vector<Bridge> free = run(stack, 0, &ev);
+    CHECK(max_partners(free) == 3);
+    CHECK(ev.capped == 0);
+    for (int cap : {1, 2}) {
+        INFO("cap " << cap);
+        const std::vector<Bridge> b = run(stack, cap, &ev);
+        CHECK(max_partners(b) == cap);
+        CHECK(ev.capped > 0);
+        CHECK(ev.formed == static_cast<int>(b.size()));
+        CHECK(b.size() < free.size());
+    }
+    CHECK(run(stack, 3).size() == free.size());  // a cap the stack does not reach changes nothing
+
+    // A fifth fiber across the stack: at 5 deg (aligned: a crossing within the contact angle) it gets no bridge where
+    // the cap is full; at 60 deg it crosses, and point crossings are not bundles: one bridge per stack fiber.
+    for (double angle : {5.0, 60.0}) {
+        INFO("crossing at " << angle << " deg");
+        std::vector<Line> lines = stack;
+        lines.push_back({1.55, 1.5075, angle, 1, 0.5});
+        const std::vector<Bridge> uncapped = run(lines, 0, nullptr, true), capped = run(lines, 1, nullptr, true);
+        CHECK(bridges_with(uncapped, 4) >= 4);
+        if (angle < 10) CHECK(bridges_with(capped, 4) == 0);
+        else CHECK(bridges_with(capped, 4) == bridges_with(uncapped, 4));
+    }
 }
 
 namespace {

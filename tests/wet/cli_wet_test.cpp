@@ -29,6 +29,9 @@ TEST_CASE("cli wet: a small run writes its documented outputs", "[wet][cli]") {
     CHECK(j.find("\"capillary\"") != std::string::npos);
     CHECK(j.find("\"parameters\"") != std::string::npos);  // what generated the network
     CHECK(j.find("\"pl\": 1.0") != std::string::npos);
+    CHECK(j.find("\"strain\": \"shear\"") != std::string::npos);  // the load the run was under, with gamma
+    CHECK(j.find("\"bundle_partners\": 0") != std::string::npos);    // no cap by default
+    CHECK(j.find("\"capped\": 0") != std::string::npos);
     CHECK(j.find("\"stable\"") != std::string::npos);
     CHECK(j.find("\"local_rounds\": 0") != std::string::npos);  // beta = 0: one global solve
     CHECK(j.find("\"complete\": true") != std::string::npos);  // false in the copies written between betas
@@ -88,6 +91,8 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
     };
     for (const Case& c : {Case{"--beta -1", "beta = -1"}, Case{"--beta nan", "beta"}, Case{"--betas 0,-0.5", "-0.5"},
                           Case{"--crossings fraction --fraction 2", "fraction = 2"},
+                          Case{"--fraction 0.5", "fraction = 0.5 is used only with crossings = fraction"},
+                          Case{"--bundle-partners -1", "bundle_partners = -1"},
                           Case{"--crossings some", "some"}, Case{"--law " + law, "100"},
                           Case{"--law " + unsorted, "30"}, Case{scene, "fraction = 1.5"},
                           Case{"--prune ends", "prune \"ends\" is not valid for `fibernet wet`"},

@@ -34,6 +34,8 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
     CHECK(parse_scene("", "empty.toml").wet.local_fraction == ActiveSetOptions{}.local_fraction);
     CHECK(parse_scene("", "empty.toml").wet.local_threshold == ActiveSetOptions{}.local_threshold);
     CHECK(parse_scene("", "empty.toml").wet.local_hops == ActiveSetOptions{}.local_hops);
+    CHECK(parse_scene("", "empty.toml").wet.bundle_partners == ActiveSetOptions{}.bundle_partners);
+    CHECK(parse_scene("[wet]\nbundle_partners = 2\n", "b.toml").wet.bundle_partners == 2);
     struct Bad {
         std::string toml, needle;
     };
@@ -52,6 +54,9 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
                          Bad{"[wet]\nlocal_fraction = nan\n", "[wet].local_fraction = nan"},
                          Bad{"[wet]\nlocal_threshold = 0\n", "[wet].local_threshold = 0"},
                          Bad{"[wet]\nlocal_hops = -1\n", "[wet].local_hops = -1"},
+                         Bad{"[wet]\nbundle_partners = -1\n", "[wet].bundle_partners = -1"},
+                         Bad{"[wet]\nfraction = 0.5\n", "[wet].fraction = 0.5 is used only with crossings = fraction"},
+                         Bad{"[wet]\nbundle_partners = 1.5\n", "[wet].bundle_partners"},
                          Bad{"[wet]\nlaw = \"/nonexistent/law.txt\"\n", "/nonexistent/law.txt"}}) {
         INFO(b.toml);
         try {

@@ -37,6 +37,9 @@ struct WetSettings {
     double local_fraction = 0.25;
     double local_threshold = 0.1;
     int local_hops = 3;
+    // Excluded volume in bundles: a segment adheres along at most this many other fibers (0: no cap; 2: flat ribbon,
+    // 6: close-packed; ActiveSetOptions::bundle_partners, docs/wet.md "Bundle partners").
+    int bundle_partners = 0;
 };
 
 struct Scene {

@@ -40,6 +40,7 @@ namespace fibernet {
 
 struct WetEvents {
     int moves = 0, ruptures = 0, formed = 0, merged = 0, locked = 0;
+    int capped = 0;  // aligned crossings and contacts left without a bridge by ActiveSetOptions::bundle_partners
     int total() const { return moves + ruptures + formed + merged; }
 };
 
@@ -71,6 +72,13 @@ struct ActiveSetOptions {
     int max_freezes = 5;          // cycles broken by freezing their fiber pairs before cycling is final,
     int bridges_per_freeze = 2000;  // and one more per this many bridges: a large network cycles in more places
     double move_margin = 0.1;     // a bridge moves once its crossing is this fraction of the blend half-width past a node
+    // > 0: excluded volume in bundles. A segment adheres along at most this many other fibers: a new aligned bridge
+    // (a contact, or a crossing within contact_angle) is not formed if either of its segments already holds aligned
+    // bridges (locked, or within contact_angle) with this many fibers other than the new partner (counted as capped).
+    // Existing bridges are never removed for it (no energy jump, no cycling), so the cap binds on new bundles only.
+    // 2: a flat ribbon (each fiber between two neighbours); 6: a close-packed 3D bundle. 0: no cap (2D stacking
+    // unbounded: a bundle of k fibers on one line holds k(k-1)/2 adhering pairs; docs/wet.md, "Bundle partners").
+    int bundle_partners = 0;
 };
 
 // Fiber pairs (lower index first).

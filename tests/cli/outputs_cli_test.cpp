@@ -1,0 +1,60 @@
+// Output paths of rigidity, percolation and compare are checked before any work (exit 2, nothing written);
+// percolation --resume refuses another --seed; compare reports progress per network.
+#include <catch2/catch.hpp>
+
+#include "../support/cli_run.hpp"
+
+using namespace clitest;
+
+TEST_CASE("cli rigidity: a bad --out leaves no --svg behind", "[cli][rigidity][input]") {
+    const std::string svg = tmpdir() + "/rig.svg", json = tmpdir() + "/nodir/rig.json";
+    CHECK(run("rigidity --L 4 --q 6 --open --svg " + svg + " --out " + json) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("--out '" + json + "'") != std::string::npos);
+    CHECK(!exists(svg));
+    // One file for both: the JSON would replace the picture.
+    CHECK(run("rigidity --L 4 --q 6 --open --svg " + svg + " --out " + svg) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("also given as --svg") != std::string::npos);
+    CHECK(!exists(svg));
+}
+
+TEST_CASE("cli percolation: a bad --table is refused before any sample", "[cli][percolation][input]") {
+    const std::string csv = tmpdir() + "/perc_table.csv", table = tmpdir() + "/nodir/t.csv";
+    const std::string base = "percolation --pl 1 --L 3 --q-min 4 --q-max 5 --q-step 1 --samples 2 --out " + csv;
+    CHECK(run(base + " --table " + table) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("--table '" + table + "'") != std::string::npos);
+    CHECK(slurp(tmpdir() + "/stderr").find("samples") == std::string::npos);  // no progress: nothing ran
+    CHECK(!exists(csv));
+    CHECK(run(base + " --summary " + tmpdir() + "/nodir/s.json") == 2);
+    CHECK(!exists(csv));
+    CHECK(run(base + " --table " + csv) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("also given as --out") != std::string::npos);
+    CHECK(!exists(csv));
+}
+
+TEST_CASE("cli percolation: --resume refuses samples of another --seed", "[cli][percolation][input]") {
+    const std::string csv = tmpdir() + "/perc_seed.csv";
+    const std::string base = "percolation --pl 1 --L 3 --q-min 4 --q-max 5 --q-step 1 --out " + csv;
+    REQUIRE(run(base + " --samples 2 --seed 3") == 0);
+    const std::string rows = slurp(csv);
+    CHECK(run(base + " --samples 3 --seed 7 --resume") == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find(csv + ":2: seed = ") != std::string::npos);
+    CHECK(slurp(tmpdir() + "/stderr").find("is not the seed --seed 7 gives") != std::string::npos);
+    CHECK(slurp(csv) == rows);
+    CHECK(run(base + " --samples 3 --resume") == 2);  // the default --seed 1 is another seed too
+    REQUIRE(run(base + " --samples 3 --seed 3 --resume") == 0);
+    CHECK(slurp(csv).size() > rows.size());
+}
+
+TEST_CASE("cli compare: --out is checked first; progress per network on stderr, -q silences it", "[cli][compare]") {
+    const std::string json = tmpdir() + "/nodir/cmp.json";
+    // --max-dofs 10 would refuse the first network: the --out message shows that nothing was generated first.
+    CHECK(run("compare --open --L 2.5 --q 6 --samples 2 --max-dofs 10 --out " + json) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("--out '" + json + "'") != std::string::npos);
+    REQUIRE(run("compare --open --L 2.5 --q 6 --pl 0.8 --seed 5 --samples 2") == 0);
+    const std::string err = slurp(tmpdir() + "/stderr");
+    CHECK(err.find("compare: network 1 of 2 (seed 5)") != std::string::npos);
+    CHECK(err.find("compare: network 2 of 2 (seed 6)") != std::string::npos);
+    CHECK(err.find("floppy modes") != std::string::npos);
+    REQUIRE(run("compare --open --L 2.5 --q 6 --pl 0.8 --seed 5 --samples 2 -q") == 0);
+    CHECK(slurp(tmpdir() + "/stderr").empty());
+}
