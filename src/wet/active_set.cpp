@@ -611,7 +611,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         r.seconds_update += now() - t0;
         r.events.moves += ev.moves, r.events.ruptures += ev.ruptures;
         r.events.formed += ev.formed, r.events.merged += ev.merged, r.events.locked += ev.locked;
-        r.events.capped += ev.capped;
+        r.events.capped = ev.capped;  // a state count (the same candidates are refused every round), not a sum
         // Moves, locks and fade-out ruptures leave the energy unchanged near q: if the updated set's gradient at q is
         // no larger than the one the solver accepted, q is already an equilibrium of it (and beta = 0 stays bit for
         // bit the dry result). After a local round this is the whole network's gradient against the region's

@@ -307,7 +307,8 @@ public:
 
     void add_events(const WetEvents& e) {
         R_.events.moves += e.moves, R_.events.ruptures += e.ruptures, R_.events.formed += e.formed;
-        R_.events.merged += e.merged, R_.events.locked += e.locked, R_.events.capped += e.capped;
+        R_.events.merged += e.merged, R_.events.locked += e.locked;
+        R_.events.capped = e.capped;  // the last relaxation's state count
     }
 
 private:

@@ -40,7 +40,9 @@ namespace fibernet {
 
 struct WetEvents {
     int moves = 0, ruptures = 0, formed = 0, merged = 0, locked = 0;
-    int capped = 0;  // aligned crossings and contacts left without a bridge by ActiveSetOptions::bundle_partners
+    // Aligned crossings and contacts left without a bridge by ActiveSetOptions::bundle_partners at one update (the
+    // same candidates are refused every round); a relaxation's result holds its last update's count, not a sum.
+    int capped = 0;
     int total() const { return moves + ruptures + formed + merged; }
 };
 
