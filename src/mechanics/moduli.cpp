@@ -256,7 +256,11 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
             Mo.response = U.col(m) - V.col(m);  // H (u - v) = (b + H v) - H v = E_xt
             Mo.correction = c[m];
             Mo.value = modes[m].scale * (Mo.E_tt - c[m]);
-            Mo.error = modes[m].scale * std::max(tail, 1e-15 * scale_ref[m]);  // floor at the cancellation round-off
+            // Floored at the round-off of the cancellation E_tt - c, sums over n terms of size scale_ref (the
+            // classical bound n eps: a floor of 1e-15 scale_ref let a floppy network's G = -1.7e-11 stand 200
+            // errors below zero).
+            Mo.error = modes[m].scale * std::max(tail, std::max(1e-15, n * std::numeric_limits<double>::epsilon()) *
+                                                           scale_ref[m]);
             // Accepted when converged, or stopped by round-off with the tail below 1e-7 of the cancellation scale
             // (the seed scheme's 1e-4 segments at L = 20 end there; the error is reported).
             Mo.ok = std::isfinite(Mo.value) && !broke[m] && (conv[m] || tail <= 1e-7 * scale_ref[m]);
