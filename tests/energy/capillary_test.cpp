@@ -51,6 +51,31 @@ TEST_CASE("capillary: gradient and Hessian match finite differences at all angle
         }
 }
 
+TEST_CASE("capillary: a table that does not span 0-90 deg is continued linearly, C2, with exact derivatives",
+          "[energy][capillary][gradient][hessian]") {
+    // A Surface Evolver table often stops short of 0 and 90 deg: here 10 ... 80 deg. Outside, the natural spline is
+    // continued along its end tangent (CapillaryLaw::eval).
+    std::vector<double> a, v;
+    for (int deg = 10; deg <= 80; deg += 5) {
+        const double r = deg * M_PI / 180;
+        a.push_back(deg), v.push_back(-std::cos(r) * std::cos(r) + 0.1 * std::sin(2 * r) * std::sin(2 * r));
+    }
+    const CapillaryLaw law = CapillaryLaw::tabulated(a, v, "partial table");
+    for (double deg : {0.0, 1e-3, 5.0, 9.0, 45.0, 81.0, 85.0, 89.9, 90.0, 100.0, 175.0})
+        for (double len2 : {1.0, 0.1}) check_bridge(law, deg, len2);
+    // Across each end of the table (c = cos^2 alpha at 10 and 80 deg): value, slope and curvature continuous.
+    for (double deg : {10.0, 80.0}) {
+        const double c = std::pow(std::cos(deg * M_PI / 180), 2), h = 1e-7;
+        double p0, d0, s0, p1, d1, s1;
+        law.eval(c - h, p0, d0, s0);
+        law.eval(c + h, p1, d1, s1);
+        INFO("table end at " << deg << " deg");
+        CHECK(std::abs(p1 - p0) <= 1e-6);
+        CHECK(std::abs(d1 - d0) <= 1e-5);
+        CHECK(std::abs(s1 - s0) <= 1e-4 * (1 + std::abs(s0)));
+    }
+}
+
 TEST_CASE("capillary: default law has E(90) - E(0) = beta l and no torque at 0 and 90 deg", "[energy][capillary]") {
     const CapillaryLaw law;
     const Eigen::Vector2d d1(1, 0);

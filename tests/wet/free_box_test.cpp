@@ -93,10 +93,18 @@ void check_free_box(const Model& m, const FreeBoxResult& f, const WetParams& p, 
 
 TEST_CASE("wet stress: the capillary term equals dE/dF of the wet energy at fixed q", "[wet][free_box]") {
     const Network net = mikado(2.5, 6, 0.8, 2);
-    const Model m = model_of(net, 10);
+    // Also with fixed nodes (clamps): a fixed node sits at F x_ref, so its bridges' elements move with F (the
+    // x_ref term of wet_stress).
+    for (bool clamped : {false, true}) {
+    Model m = model_of(net, 10);
+    if (clamped) {
+        m.fixed.assign(m.num_nodes(), 0);
+        for (int i = 0; i < m.num_nodes(); i += 5) m.fixed[i] = 1;
+    }
     NetworkEnergy dry(m);
     for (const Eigen::Matrix2d& F : {Eigen::Matrix2d(Eigen::Matrix2d::Identity()),
                                      Eigen::Matrix2d((Eigen::Matrix2d() << 0.97, 0.04, -0.01, 1.02).finished())}) {
+        INFO((clamped ? "every 5th node fixed" : "no fixed nodes"));
         // A perturbed state (not an equilibrium: P is the partial derivative at fixed q either way), a bridge at
         // every network crossing (on the seed scheme crossings are nodes: the bridges sit inside blend zones).
         Eigen::VectorXd q = perturb(dry.affine_map(dry.dofs(m.x), Eigen::Matrix2d::Identity(), F), 0.05, 7);
@@ -111,6 +119,7 @@ TEST_CASE("wet stress: the capillary term equals dE/dF of the wet energy at fixe
         CHECK((s.P - P_dry).norm() > 0.1);  // the capillary term matters here
         CHECK((s.P - P_fd).norm() <= 1e-6 * P_fd.norm());
         CHECK(s.sigma.isApprox(cauchy(s.P, F, m), 1e-14));
+    }
     }
 }
 

@@ -14,8 +14,10 @@ using namespace fibernet;
 using namespace wetfix;
 
 namespace {
+// strained: the layout puts the bridges' elements across the box edge, so their strain terms must not vanish (else
+// the strain checks below compare 0 with 0).
 void check_derivatives(const Model& m, const Eigen::Matrix2d& F, double amp, std::uint64_t seed, const CapillaryLaw& law,
-                       int min_bridges) {
+                       int min_bridges, bool strained = false) {
     NetworkEnergy dry(m);
     const Eigen::Matrix2d B = F * m.box.B0();
     Eigen::VectorXd q = dry.affine_map(dry.dofs(m.x), Eigen::Matrix2d::Identity(), F);
@@ -93,7 +95,20 @@ void check_derivatives(const Model& m, const Eigen::Matrix2d& F, double amp, std
         CHECK(std::abs(w.d2E_dt2 - Ett_fd) <= 1e-5 * (1e-3 + std::abs(Ett_fd)));
         CHECK(fdtest::rel_err(w.d2E_dqdt - d.d2E_dqdt, b_fd - b0_fd, 1e-3) < 1e-5);
         CHECK(fdtest::rel_err(w.d2E_dqdt, b_fd) < 1e-6);
+        if (strained) {
+            CHECK(std::abs(w.dE_dt - d.dE_dt) > 1e-4);
+            CHECK(std::abs(w.d2E_dt2 - d.d2E_dt2) > 1e-4);
+            CHECK((w.d2E_dqdt - d.d2E_dqdt).norm() > 1e-4);
+        }
     }
+}
+
+// The layout moved by (dx, dy): in a periodic box, by about -1.33 the home segments of the crossings near x = 1.31
+// straddle the box edge, so that their bridges' elements hold periodic shifts and F enters them (strain derivatives
+// of an element without shifts or fixed nodes vanish: a check there compares 0 with 0).
+std::vector<Line> moved_by(std::vector<Line> lines, double dx, double dy) {
+    for (Line& l : lines) l.x += dx, l.y += dy;
+    return lines;
 }
 
 CapillaryLaw table() {
@@ -109,18 +124,32 @@ CapillaryLaw table() {
 TEST_CASE("wet energy: gradient and Hessian match finite differences", "[wet][gradient][hessian]") {
     const CapillaryLaw def, tab = table();
     // Fiber 1 along x with nodes every 0.1; fiber 2 crosses it 0.01 (blend zone: |z| < 0.025) past a node.
+    Eigen::Matrix2d sheared;
+    sheared << 1, 0.3, 0, 1.1;
     SECTION("blend zone on one fiber") {
-        const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.31, 1.5, 60, 1, 0.45}}, 3));
+        const std::vector<Line> lines = {{1.5, 1.5, 0, 1, 0.5}, {1.31, 1.5, 60, 1, 0.45}};
+        const Model m = model_of(network_of(lines, 3));
         for (int s = 0; s < 3; ++s) check_derivatives(m, Eigen::Matrix2d::Identity(), 0.003, 11 + s, def, 1);
         check_derivatives(m, Eigen::Matrix2d::Identity(), 0.003, 21, tab, 1);
+        // On the box edge, sheared: the blend zone's strain derivatives.
+        const Model e = model_of(network_of(moved_by(lines, -1.33, -1.49), 3));
+        check_derivatives(e, sheared, 0.003, 22, def, 1, true);
+        check_derivatives(e, sheared, 0.003, 23, tab, 1, true);
     }
     SECTION("blend zones on both fibers") {
-        const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.31, 1.5, 70, 1, 0.41}}, 3));
+        const std::vector<Line> lines = {{1.5, 1.5, 0, 1, 0.5}, {1.31, 1.5, 70, 1, 0.41}};
+        const Model m = model_of(network_of(lines, 3));
         for (int s = 0; s < 3; ++s) check_derivatives(m, Eigen::Matrix2d::Identity(), 0.003, 31 + s, def, 1);
+        const Model e = model_of(network_of(moved_by(lines, -1.33, -1.49), 3));
+        check_derivatives(e, sheared, 0.003, 34, def, 1, true);
+        check_derivatives(e, sheared, 0.003, 35, tab, 1, true);
     }
     SECTION("crossing near a fiber end (missing neighbour)") {
-        const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.005, 1.5, 50, 1, 0.5}}, 3));
+        const std::vector<Line> lines = {{1.5, 1.5, 0, 1, 0.5}, {1.005, 1.5, 50, 1, 0.5}};
+        const Model m = model_of(network_of(lines, 3));
         for (int s = 0; s < 3; ++s) check_derivatives(m, Eigen::Matrix2d::Identity(), 0.002, 41 + s, def, 1);
+        const Model e = model_of(network_of(moved_by(lines, -1.03, -1.49), 3));
+        check_derivatives(e, sheared, 0.002, 44, def, 1, true);
     }
     SECTION("interior crossings, several fibers") {
         const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.55, 1.5, 60, 1, 0.45}, {1.5, 1.55, 100, 1, 0.5}}, 3));
