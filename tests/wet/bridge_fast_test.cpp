@@ -113,12 +113,21 @@ TEST_CASE("bridge element: chain rule through the signed distances equals the Je
 }
 
 TEST_CASE("bridge element: derivatives match finite differences while lambda or the window fades", "[wet][bridge][gradient]") {
-    // The network tests rarely reach the near-parallel fade or the window's end; check them here directly.
+    // The network tests rarely reach the near-parallel fade, the window's end or a locked (bundle) bridge; check them
+    // here directly, with the default law and a tabulated one. (Strain derivatives are these derivatives along
+    // dX_a = dF B0 shift_a: WetEnergy::strain_derivatives composes them, checked in wet_energy_test.cpp.)
     Rng rng(7);
-    CapillaryLaw law;
-    for (int n = 0; n < 80; ++n) {
+    std::vector<double> ta, tv;
+    for (int i = 0; i <= 18; ++i) {
+        const double r = 5.0 * i * M_PI / 180;
+        ta.push_back(5.0 * i), tv.push_back(-std::cos(r) * std::cos(r) + 0.1 * std::sin(2 * r) * std::sin(2 * r));
+    }
+    const CapillaryLaw table = CapillaryLaw::tabulated(ta, tv, "test table");
+    const Kind kinds[] = {Kind::Fade, Kind::Far, Kind::Locked};
+    for (int n = 0; n < 180; ++n) {
+        const CapillaryLaw law = n % 2 ? table : CapillaryLaw();
         BridgeElement e;
-        const Vector16d X0 = random_element(rng, n < 40 ? Kind::Fade : Kind::Far, e);
+        const Vector16d X0 = random_element(rng, kinds[n / 60], e);
         const Eigen::VectorXd X = X0;
         auto val = [&](const Eigen::VectorXd& v) {
             return bridge_element_energy(e, Vector16d(v), 1.0, law, nullptr, nullptr);
