@@ -2,9 +2,11 @@
 // continuously off a fiber end, form at new crossings and contacts; the outer loop terminates and reports.
 #include <catch2/catch.hpp>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include "fibernet/wet/active_set.hpp"
 #include "fibernet/wet/wet_energy.hpp"
@@ -192,6 +194,69 @@ TEST_CASE("active set: a bridge sliding off a fiber end fades out and ruptures",
     CHECK(d.E.front() == Approx(-0.25));
     CHECK(d.E[100] == Approx(-0.125));  // crossing at the fiber end: half the weight
     CHECK(d.max_step < 0.02 * 0.25);
+}
+
+TEST_CASE("active set: the segment crossing search finds exactly the brute-force crossings", "[wet][events]") {
+    // Every pair of segments of different fibers, at every periodic image -1..1, against the cell search; dense and
+    // sparse networks (the sparse one, 800 fibers in a box of 40 fiber lengths, where the cell grid is capped at ~4 cells per
+    // segment), periodic sheared and open.
+    struct Case {
+        double L, q;
+        bool periodic;
+    };
+    for (const Case& c : {Case{4, 6, true}, Case{4, 6, false}, Case{40, 0.5, true}, Case{40, 0.5, false}}) {
+        MikadoParams mp;
+        mp.L = c.L, mp.q = c.q, mp.pl = 0.5, mp.seed = 3, mp.periodic = c.periodic;
+        const Model m = model_of(generate_mikado(mp), 10);
+        NetworkEnergy e(m);
+        Eigen::Matrix2d F = Eigen::Matrix2d::Identity();
+        if (c.periodic) F(0, 1) = 0.2;
+        const Eigen::Matrix2d B = F * m.box.B0();
+        const Eigen::VectorXd x = e.positions(perturb(e.affine_map(e.dofs(m.x), I2, F), 0.3, 5), F);
+        std::vector<int> fiber(m.segments.size()), pos(m.segments.size());
+        for (size_t f = 0; f < m.chains.size(); ++f)
+            for (size_t k = 0; k < m.chains[f].segments.size(); ++k)
+                fiber[m.chains[f].segments[k]] = static_cast<int>(f), pos[m.chains[f].segments[k]] = static_cast<int>(k);
+        std::set<std::array<int, 4>> brute, found;
+        for (size_t a = 0; a < m.segments.size(); ++a)
+            for (size_t b = a + 1; b < m.segments.size(); ++b) {
+                const Segment &sa = m.segments[a], &sb = m.segments[b];
+                // A crosslink's segments meet at its shared node: a pin, not a crossing for a bridge.
+                if (fiber[a] == fiber[b] || sa.i == sb.i || sa.i == sb.j || sa.j == sb.i || sa.j == sb.j) continue;
+                const Eigen::Vector2d Pa = x.segment<2>(2 * sa.i), Pb = x.segment<2>(2 * sb.i);
+                const Eigen::Vector2d Da = x.segment<2>(2 * sa.j) - Pa + B * sa.shift.cast<double>();
+                const Eigen::Vector2d Db = x.segment<2>(2 * sb.j) - Pb + B * sb.shift.cast<double>();
+                const int r = c.periodic ? 1 : 0;
+                for (int i = -r; i <= r; ++i)
+                    for (int j = -r; j <= r; ++j) {
+                        const Eigen::Vector2d Q = Pb + B * Eigen::Vector2d(i, j);
+                        const double den = Da.x() * Db.y() - Da.y() * Db.x();
+                        if (den == 0) continue;
+                        const Eigen::Vector2d w = Q - Pa;
+                        const double t = (w.x() * Db.y() - w.y() * Db.x()) / den, u = (w.x() * Da.y() - w.y() * Da.x()) / den;
+                        if (t >= 0 && t < 1 && u >= 0 && u < 1) {
+                            std::array<int, 4> k{fiber[a], pos[a], fiber[b], pos[b]};
+                            if (k[0] > k[2]) std::swap(k[0], k[2]), std::swap(k[1], k[3]);
+                            brute.insert(k);
+                        }
+                    }
+            }
+        for (const Bridge& br : segment_crossings(m, x, B)) {
+            std::array<int, 4> k{br.f1, br.k1, br.f2, br.k2};
+            if (k[0] > k[2]) std::swap(k[0], k[2]), std::swap(k[1], k[3]);
+            found.insert(k);
+        }
+        INFO("L " << c.L << ", q " << c.q << (c.periodic ? ", periodic" : ", open") << ": " << brute.size()
+                  << " brute-force crossings");
+        std::ostringstream diff;
+        for (const auto& k : brute)
+            if (!found.count(k)) diff << " missed " << k[0] << "/" << k[1] << "-" << k[2] << "/" << k[3];
+        for (const auto& k : found)
+            if (!brute.count(k)) diff << " extra " << k[0] << "/" << k[1] << "-" << k[2] << "/" << k[3];
+        INFO(diff.str());
+        CHECK(brute.size() > 10);
+        CHECK(found == brute);
+    }
 }
 
 TEST_CASE("active set: a new crossing gets a bridge", "[wet][events]") {
