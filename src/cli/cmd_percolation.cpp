@@ -13,6 +13,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <mutex>
 #include <set>
 #include <sstream>
@@ -48,9 +49,11 @@ using Key = std::tuple<std::string, std::string, int>;  // L, q as written, samp
 
 // Reads the rows of an existing CSV; lines that do not parse (an interrupted write) are skipped. Refuses rows that
 // this run's --pl and --seed would not have made: resuming them would mix two runs. seed_of(row) is the seed the
-// base seed gives for the row's L, q and sample.
+// base seed gives for the row's L, q and sample, if the row is on this run's grid (a row off it, e.g. of an L left
+// out on resume, keeps its seed: its L and q are known only to the 10 digits written, which the seed's hash of the
+// exact values cannot be checked against).
 std::vector<PercolationSample> read_rows(const std::string& path, double pl, std::uint64_t base_seed,
-                                         const std::function<std::uint64_t(const PercolationSample&)>& seed_of,
+                                         const std::function<std::optional<std::uint64_t>(const PercolationSample&)>& seed_of,
                                          bool& ends_with_newline) {
     std::ifstream in(path);
     std::vector<PercolationSample> rows;
@@ -75,11 +78,12 @@ std::vector<PercolationSample> read_rows(const std::string& path, double pl, std
         if (std::abs(s.pl - pl) > 1e-12)
             throw InputError(path + ":" + std::to_string(lineno) + ": pl = " + fmt(s.pl) + " differs from --pl " + fmt(pl));
         s.seed = seed, s.rigid = rigid, s.connected = conn;
-        if (s.seed != seed_of(s))
+        const std::optional<std::uint64_t> expected = seed_of(s);
+        if (expected && s.seed != *expected)
             throw InputError(path + ":" + std::to_string(lineno) + ": seed = " + std::to_string(s.seed) + " of L = " +
                              fmt(s.L) + ", q = " + fmt(s.q) + ", sample " + std::to_string(s.sample) +
                              " is not the seed --seed " + std::to_string(base_seed) + " gives (" +
-                             std::to_string(seed_of(s)) + "): the CSV was written with another --seed");
+                             std::to_string(*expected) + "): the CSV was written with another --seed");
         rows.push_back(s);
     }
     return rows;
@@ -167,10 +171,10 @@ void register_percolation(CLI::App& app) {
                 const double q = std::round((o->q_min + k * o->q_step) * 1e9) / 1e9;
                 grid[{fmt(L), fmt(q)}] = {L, q};
             }
-        auto seed_of = [&](const PercolationSample& r) {
+        auto seed_of = [&](const PercolationSample& r) -> std::optional<std::uint64_t> {
             auto it = grid.find({fmt(r.L), fmt(r.q)});
-            return it == grid.end() ? percolation_seed(o->seed, r.L, r.q, r.sample)
-                                    : percolation_seed(o->seed, it->second.first, it->second.second, r.sample);
+            if (it == grid.end()) return std::nullopt;
+            return percolation_seed(o->seed, it->second.first, it->second.second, r.sample);
         };
         std::vector<PercolationSample> rows;
         bool newline = true;

@@ -43,6 +43,10 @@ nlohmann::json sweep_parameters(const Scene& s, const SweepParams& p) {
         std::uint64_t h = 1469598103934665603ull;  // FNV-1a
         for (char c; is.get(c);) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
         j["network_file_fnv1a"] = h;
+        // The file by its canonical path: the same file named from another directory or as ./x.net is the same sweep.
+        std::error_code ec;
+        const std::filesystem::path canon = std::filesystem::weakly_canonical(s.network_file, ec);
+        if (!ec) j["network_file"] = canon.string();
     }
     j["fiber_length"] = s.discretization.fiber_length;
     j["prune"] = prune_rules(s);
@@ -68,9 +72,12 @@ std::string flag_of(const std::string& key) {
 
 std::string shown(const nlohmann::json& v) { return v.is_null() ? "(none)" : v.is_string() ? v.get<std::string>() : v.dump(); }
 
-void write_checkpoint(const std::string& path, const nlohmann::json& params, int rows, const SweepState& s) {
+// completed: the sweep reached gamma_max (a run without --resume may then start over; --resume adds nothing).
+void write_checkpoint(const std::string& path, const nlohmann::json& params, int rows, const SweepState& s,
+                      bool completed = false) {
     std::ostringstream os;
-    os << std::setprecision(17) << "fibernet-sweep-checkpoint 2\nparameters " << params.dump() << "\ndofs "
+    os << std::setprecision(17) << "fibernet-sweep-checkpoint 2\nparameters " << params.dump() << "\ncompleted "
+       << (completed ? 1 : 0) << "\ndofs "
        << s.q.size() << "\nrows " << rows << "\nstep " << s.step << "\nt " << s.t << "\nnext_step " << s.next_step
        << "\nq\n";
     for (int i = 0; i < s.q.size(); ++i) os << s.q[i] << '\n';
@@ -79,8 +86,18 @@ void write_checkpoint(const std::string& path, const nlohmann::json& params, int
 
 struct Checkpoint {
     int dofs = 0, rows = 0;
+    bool completed = false;
     SweepState state;
 };
+
+// Whether the checkpoint at `path` records a completed sweep (false for anything else, also unreadable files).
+bool completed_checkpoint(const std::string& path) {
+    std::ifstream is(path);
+    std::string key, line;
+    int version = 0, done = 0;
+    return (is >> key >> version) && version == 2 && (is >> key) && key == "parameters" && std::getline(is, line) &&
+           (is >> key >> done) && key == "completed" && done == 1;
+}
 
 // Reads a checkpoint and refuses it unless it was written with this run's parameters (each difference is named).
 Checkpoint read_checkpoint(const std::string& path, const nlohmann::json& params) {
@@ -107,6 +124,9 @@ Checkpoint read_checkpoint(const std::string& path, const nlohmann::json& params
     for (auto it = recorded.begin(); it != recorded.end(); ++it)  // e.g. a network file against a generated network
         if (!params.contains(it.key()))
             fail(it.key() + " = " + shown(it.value()) + " is not a parameter of this run" + flag_of(it.key()));
+    int done = 0;
+    if (!(is >> key >> done) || key != "completed" || (done != 0 && done != 1)) fail("missing completed");
+    c.completed = done == 1;
     if (!(is >> key >> c.dofs) || key != "dofs" || c.dofs < 0) fail("missing dofs");
     if (!(is >> key >> c.rows) || key != "rows") fail("missing rows");
     if (!(is >> key >> s.step) || key != "step") fail("missing step");
@@ -152,8 +172,8 @@ void register_sweep(CLI::App& app) {
     // A sweep's strain comes from --gamma-max: hide the scene flag --gamma (kept registered, so that giving it
     // still gets the message below rather than CLI11's "not expected").
     cmd->get_option("--gamma")->group("");
-    cmd->footer("Like `fibernet percolation --out`, an existing checkpoint is refused without --resume (its sweep "
-                "would be lost); without a checkpoint an existing CSV is replaced.");
+    cmd->footer("Like `fibernet percolation --out`, the checkpoint of an unfinished sweep is refused without --resume "
+                "(its sweep would be lost); a completed sweep, or an existing CSV without a checkpoint, is replaced.");
     cmd->callback([=] {
         Scene s = flags->resolve();
         if (flags->given("--gamma")) throw InputError("command line: sweep takes --gamma-max, not --gamma");
@@ -162,9 +182,9 @@ void register_sweep(CLI::App& app) {
         if (ckpt->empty()) *ckpt = *out + ".ckpt";
         check_outputs({{"-o", *out}, {"--checkpoint", *ckpt}});
         std::error_code ec;
-        if (!*resume && std::filesystem::is_regular_file(*ckpt, ec))
+        if (!*resume && std::filesystem::is_regular_file(*ckpt, ec) && !completed_checkpoint(*ckpt))
             throw InputError("command line: --checkpoint '" + *ckpt +
-                             "' exists (an earlier sweep); add --resume to continue it, or remove it");
+                             "' exists (an unfinished sweep); add --resume to continue it, or remove it");
         const nlohmann::json params = sweep_parameters(s, *p);
         Checkpoint c;
         if (*resume) c = read_checkpoint(*ckpt, params);  // before any work: a mismatch costs nothing
@@ -194,9 +214,11 @@ void register_sweep(CLI::App& app) {
         if (!csv) throw InputError("cannot append to '" + *out + "'");
         SweepCallbacks cb;
         cb.stop = &g_stop;
+        SweepState last = start;
         cb.on_step = [&](const SweepRow& r, const SweepState& st) {
             csv << csv_row(r) << '\n' << std::flush;
             write_checkpoint(*ckpt, params, ++rows, st);
+            last = st;
             if (!*quiet)
                 std::cerr << "sweep: step " << r.step << "  gamma = " << r.t << "  s = " << r.stress_path
                           << "  K = " << r.K << "  iterations = " << r.iterations << "  retries = " << r.retries
@@ -207,6 +229,7 @@ void register_sweep(CLI::App& app) {
         const SweepOutcome o = run_sweep(e, *p, *solver, cb, *resume ? &start : nullptr, snap.get());
         std::signal(SIGINT, SIG_DFL);
         std::signal(SIGTERM, SIG_DFL);
+        if (o.completed && rows > 0) write_checkpoint(*ckpt, params, rows, last, true);
         emit_json({{"status", o.completed ? "completed" : o.interrupted ? "interrupted" : "failed"},
                    {"message", o.message},
                    {"rows", rows},

@@ -149,7 +149,7 @@ void register_wet(CLI::App& app) {
     cmd->add_flag("-q,--quiet", w->quiet, "no progress lines on stderr (default: one per beta and per active-set round)");
     cmd->callback([=] {
         const auto t_all = std::chrono::steady_clock::now();
-        Scene s = flags->resolve();
+        Scene s = flags->resolve(false);  // checked whole below, with the [wet] flags in
         refuse_trimmed_ends(s, "wet", "capillary bridges sit on the end arms");
         if (flags->scene_file.empty() && !flags->given("--pl")) s.mikado.pl = 0.5;  // the thesis's wet networks
         if (o_beta->count()) s.wet.beta = w->beta;

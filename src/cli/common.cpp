@@ -63,7 +63,9 @@ void check_outputs(const std::vector<std::pair<std::string, std::string>>& outpu
                                  "output its own path");
         }
         files.push_back({flag, p});
-        std::string probe = (p.parent_path() / ".fibernet-probe-XXXXXX").string();
+        // The probe where write_file_atomic puts its temporary: beside the path as given (a symlinked file's own
+        // directory, not its target's).
+        std::string probe = (fs::absolute(path).parent_path() / ".fibernet-probe-XXXXXX").string();
         const int fd = mkstemp(probe.data());
         if (fd < 0)
             throw InputError(what + ": cannot create a file in directory '" + p.parent_path().string() + "' (" +
@@ -114,7 +116,7 @@ bool SceneFlags::given(const std::string& name) const {
     return false;
 }
 
-Scene SceneFlags::resolve() const {
+Scene SceneFlags::resolve(bool complete) const {
     Scene s = scene_file.empty() ? Scene{} : load_scene(scene_file);
     const std::string who = "command line";
     bool flags = false;
@@ -152,7 +154,8 @@ Scene SceneFlags::resolve() const {
             if (given(g))
                 throw InputError(std::string("command line: ") + g + " has no effect on a saved network ('" +
                                  s.network_file + "' gives the box and the fibers); remove " + g);
-    s.check();
+    if (complete) s.check();
+    else s.check_values();
     return s;
 }
 

@@ -31,7 +31,9 @@ struct SceneFlags {
     // with_load: also --gamma/--strain/--solver/--tol/--max-iter.
     void add(CLI::App* app, bool with_load);
     bool given(const std::string& name) const;
-    Scene resolve() const;  // scene file (or defaults) overridden by the flags given
+    // The scene file (or defaults) overridden by the flags given, checked (Scene::check); complete = false leaves the
+    // combined check to a command that overrides more (fibernet wet's [wet] flags), which then calls Scene::check.
+    Scene resolve(bool complete = true) const;
 };
 
 // Progress lines on stderr for a one-shot command ("modulus: 96 fibers, 2480 DOF; ..."), off with --quiet.

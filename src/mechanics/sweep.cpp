@@ -13,9 +13,11 @@ namespace fibernet {
 void SweepParams::check(const std::string& where) const {
     check_value(t_max != 0, t_max, where, "gamma_max", "must be non-zero");
     check_value(std::abs(t_max) < 10, t_max, where, "gamma_max", "must be below 10 in magnitude");
-    // det F(t) is 1 + t or (1 + t)^2 on the stretch paths, positive on [0, t_max] iff at t_max.
-    check_value(deformation(kind, t_max).determinant() > 0, t_max, where, "gamma_max",
-                "gives det F <= 0 on the " + to_string(kind) + " path (the box flips or collapses; need > -1)");
+    // F(t) is upper triangular and linear in t, with F(0) = I: the box keeps its orientation on [0, t_max] iff both
+    // diagonal entries are positive at t_max (det F alone is (1 + t)^2 > 0 on the isotropic path through t = -1).
+    const Eigen::Matrix2d Fm = deformation(kind, t_max);
+    check_value(Fm(0, 0) > 0 && Fm(1, 1) > 0, t_max, where, "gamma_max",
+                "flips or collapses the box on the " + to_string(kind) + " path (need > -1)");
     check_value(step > 0, step, where, "step", "must be > 0");
     check_value(min_step > 0 && min_step <= step, min_step, where, "min_step", "must be > 0 and <= step");
     check_value(max_step >= step, max_step, where, "max_step", "must be >= step");

@@ -14,22 +14,28 @@
 namespace fibernet {
 
 void Scene::check() const {
+    check_values();
+    // Combinations, checked once command-line overrides are in (a scene's uniaxial gamma = -2 run with --strain shear
+    // is a valid load). Every path's F = I + gamma dF is upper triangular: the box keeps its orientation iff both
+    // diagonal entries stay positive (det F > 0 alone lets isotropic gamma = -3, F = -2 I, a half turn, through).
+    const Eigen::Matrix2d F = deformation(strain, gamma);
+    check_value(F(0, 0) > 0 && F(1, 1) > 0, gamma, source, "gamma",
+                "flips or collapses the box on the " + to_string(strain) + " path (need gamma > -1)");
+    if (wet.crossings != "fraction" && wet.fraction != 1)  // else silently ignored, yet reported in the summary
+        throw InputError(source + ": [wet].fraction = " + show(wet.fraction) + " is used only with crossings = "
+                         "fraction (crossings is '" + wet.crossings + "')");
+}
+
+void Scene::check_values() const {
     if (network_file.empty()) mikado.check(source);
     discretization.check(source);
     check_value(true, gamma, source, "gamma", "");
-    // F = I + gamma dF must keep the box's orientation (uniaxial and isotropic paths: gamma > -1); a mirrored or
-    // collapsed box has no physical meaning, and its relaxation would be reported as if it had.
-    check_value(deformation(strain, gamma).determinant() > 0, gamma, source, "gamma",
-                "gives det F <= 0 on the " + to_string(strain) + " path (the box flips or collapses; need gamma > -1)");
     check_value(solver.tol > 0, solver.tol, source, "solver.tol", "must be > 0");
     check_value(solver.max_iter >= 1, solver.max_iter, source, "solver.max_iter", "must be >= 1");
     check_value(wet.beta >= 0, wet.beta, source, "[wet].beta", "must be >= 0");
     check_value(wet.fraction >= 0 && wet.fraction <= 1, wet.fraction, source, "[wet].fraction", "must lie in [0, 1]");
     if (wet.crossings != "all" && wet.crossings != "free" && wet.crossings != "fraction")
         throw InputError(source + ": [wet].crossings = '" + wet.crossings + "' is unknown (expected all, free or fraction)");
-    if (wet.crossings != "fraction" && wet.fraction != 1)  // else silently ignored, yet reported in the summary
-        throw InputError(source + ": [wet].fraction = " + show(wet.fraction) + " is used only with crossings = "
-                         "fraction (crossings is '" + wet.crossings + "')");
     check_value(wet.free_box_tol > 0, wet.free_box_tol, source, "[wet].free_box_tol", "must be > 0");
     check_value(wet.max_rounds >= 1, wet.max_rounds, source, "[wet].max_rounds", "must be >= 1");
     check_value(wet.round_iterations >= 0, wet.round_iterations, source, "[wet].round_iterations", "must be >= 0");
@@ -213,7 +219,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         r.get("bundle_partners", s.wet.bundle_partners);
         r.finish();
     }
-    s.check();
+    s.check_values();  // the combinations once overrides are in (Scene::check)
     return s;
 }
 
@@ -225,7 +231,7 @@ Scene load_scene(const std::string& path) {
     Scene s = parse_scene(ss.str(), path);
     // A network file named in a scene is found next to the scene, wherever it is run from.
     if (!s.network_file.empty() && std::filesystem::path(s.network_file).is_relative())
-        s.network_file = (std::filesystem::path(path).parent_path() / s.network_file).lexically_normal().string();
+        s.network_file = (std::filesystem::path(path).parent_path() / s.network_file).string();  // ".." as the OS resolves it
     if (!s.network_file.empty() && !std::filesystem::is_regular_file(s.network_file))
         throw InputError(path + ": [network].file = '" + s.network_file + "' is not a readable file");
     return s;

@@ -399,7 +399,9 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
             if (c2) add_partner(s2, b.f1);
         }
     }
-    // True if the new bridge c may form; an aligned one is then counted on both its segments.
+    // True if the new bridge c may form; an aligned one is then counted on both its segments. Refused segment pairs
+    // are counted once each (a pair can be both a crossing and a contact).
+    std::set<std::pair<int, int>> refused;
     auto admit = [&](const Bridge& c, bool contact) {
         const int s1 = seg_of(c.f1, c.k1), s2 = seg_of(c.f2, c.k2);
         if (cap <= 0 || (!contact && !aligned(s1, s2))) return true;
@@ -408,7 +410,10 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
             if (it == along.end()) return false;
             return static_cast<int>(it->second.size() - std::count(it->second.begin(), it->second.end(), other)) >= cap;
         };
-        if (full(s1, c.f2) || full(s2, c.f1)) return false;
+        if (full(s1, c.f2) || full(s2, c.f1)) {
+            refused.insert({std::min(s1, s2), std::max(s1, s2)});
+            return false;
+        }
         add_partner(s1, c.f2), add_partner(s2, c.f1);
         return true;
     };
@@ -432,24 +437,19 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
             }
             if (near_end) continue;
         }
-        if (!admit(c, false)) {
-            ++ev.capped;
-            continue;
-        }
+        if (!admit(c, false)) continue;
         note(c);
         bridges.push_back(c);
         ++ev.formed;
     }
     for (const Bridge& c : contacts) {
         if (partnered.count({c.f1, c.k1, c.f2}) || partnered.count({c.f2, c.k2, c.f1}) || is_frozen(c.f1, c.f2)) continue;
-        if (!admit(c, true)) {
-            ++ev.capped;
-            continue;
-        }
+        if (!admit(c, true)) continue;
         note(c);
         bridges.push_back(c);
         ++ev.formed;
     }
+    ev.capped = static_cast<int>(refused.size());
     return ev;
 }
 

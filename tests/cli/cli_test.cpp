@@ -45,7 +45,8 @@ TEST_CASE("cli: bad input exits 2, names the value and writes no output file", "
         {"nosuchcmd", "unknown command 'nosuchcmd' (expected one of: generate,"},
         {"generate --seed -1", "seed -1 is not an integer in [0, 2^64)"},
         {"generate --seed 18446744073709551616", "seed 18446744073709551616 is not an integer"},
-        {"relax --L 3 --q 5 --strain uniaxial --gamma -2", "gamma = -2 gives det F <= 0"},
+        {"relax --L 3 --q 5 --strain uniaxial --gamma -2", "gamma = -2 flips or collapses the box"},
+        {"relax --L 3 --q 5 --strain isotropic --gamma -3", "gamma = -3 flips or collapses the box"},
     };
     for (const auto& c : cases) {
         std::remove(out.c_str());

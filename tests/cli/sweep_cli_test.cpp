@@ -1,6 +1,8 @@
 // `fibernet sweep` end to end: CSV and checkpoint, resume, bad input.
 #include <catch2/catch.hpp>
 
+#include <sstream>
+
 #include "../support/cli_run.hpp"
 
 using namespace clitest;
@@ -77,16 +79,32 @@ TEST_CASE("cli sweep: --resume refuses a checkpoint of other parameters, naming 
     CHECK(slurp(tmpdir() + "/stderr").find("version 1 does not record") != std::string::npos);
 }
 
-TEST_CASE("cli sweep: an existing checkpoint needs --resume; a CSV alone is replaced", "[cli][sweep][input]") {
+TEST_CASE("cli sweep: an unfinished sweep's checkpoint needs --resume; a completed sweep or a CSV alone is replaced",
+          "[cli][sweep][input]") {
     const std::string csv = tmpdir() + "/sweep_exists.csv";
     const std::string net = "sweep --L 3 --q 7 --seed 4 --scheme even --h 2.5 --gamma-max 0.02 --step 0.01 -q -o ";
     write(csv, "not a sweep\n");
     REQUIRE(run(net + csv) == 0);  // no checkpoint: the CSV is replaced
     CHECK(slurp(csv).rfind("step,gamma,", 0) == 0);
     const std::string rows = slurp(csv);
+    CHECK(slurp(csv + ".ckpt").find("\ncompleted 1\n") != std::string::npos);
+    REQUIRE(run(net + csv) == 0);  // a completed sweep is run again (the README's sweep twice)
+    // The same rows but for the last column (wall seconds).
+    auto untimed = [](const std::string& text) {
+        std::istringstream is(text);
+        std::string line, out;
+        while (std::getline(is, line)) out += line.substr(0, line.rfind(',')) + "\n";
+        return out;
+    };
+    CHECK(untimed(slurp(csv)) == untimed(rows));
+    const std::string rows2 = slurp(csv);
+    // The same checkpoint marked unfinished (as after Ctrl-C): refused, the CSV untouched.
+    std::string ck = slurp(csv + ".ckpt");
+    ck.replace(ck.find("\ncompleted 1\n"), 13, "\ncompleted 0\n");
+    write(csv + ".ckpt", ck);
     CHECK(run(net + csv) == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("add --resume to continue it, or remove it") != std::string::npos);
-    CHECK(slurp(csv) == rows);
+    CHECK(slurp(csv) == rows2);
     CHECK(run("sweep --help") == 0);
     CHECK(slurp(tmpdir() + "/stdout").find("replaced") != std::string::npos);
 }

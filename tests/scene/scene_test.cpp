@@ -45,12 +45,18 @@ TEST_CASE("scene: bad scenes name the file, key and value", "[scene][input]") {
     // Integers out of range would wrap (max_iter = 2^32 + 2 ran 2 iterations).
     CHECK_THROWS_WITH(parse_scene("[solver]\nmax_iter = 4294967298\n", "s.toml"),
                       Catch::Contains("[solver].max_iter = 4294967298 is out of range"));
-    // A box that flips or collapses (det F <= 0) is not a load; shear keeps det F = 1 at any gamma.
-    CHECK_THROWS_WITH(parse_scene("[load]\nstrain = \"uniaxial\"\ngamma = -2\n", "s.toml"),
-                      Catch::Contains("gamma = -2 gives det F <= 0 on the uniaxial path"));
-    CHECK_THROWS_WITH(parse_scene("[load]\nstrain = \"isotropic\"\ngamma = -1\n", "s.toml"),
-                      Catch::Contains("gamma = -1 gives det F <= 0"));
-    CHECK(parse_scene("[load]\nstrain = \"shear\"\ngamma = -2\n", "s.toml").gamma == -2);
+    // A box that flips or collapses is not a load (Scene::check, once overrides are in); shear keeps det F = 1 at any
+    // gamma; isotropic gamma = -3 has det F = 4 > 0 but F = -2 I, a half turn.
+    CHECK_THROWS_WITH(parse_scene("[load]\nstrain = \"uniaxial\"\ngamma = -2\n", "s.toml").check(),
+                      Catch::Contains("gamma = -2 flips or collapses the box on the uniaxial path"));
+    CHECK_THROWS_WITH(parse_scene("[load]\nstrain = \"isotropic\"\ngamma = -1\n", "s.toml").check(),
+                      Catch::Contains("gamma = -1 flips or collapses"));
+    CHECK_THROWS_WITH(parse_scene("[load]\nstrain = \"isotropic\"\ngamma = -3\n", "s.toml").check(),
+                      Catch::Contains("gamma = -3 flips or collapses"));
+    CHECK_NOTHROW(parse_scene("[load]\nstrain = \"shear\"\ngamma = -2\n", "s.toml").check());
+    Scene over = parse_scene("[load]\nstrain = \"uniaxial\"\ngamma = -2\n", "s.toml");  // parses: values alone
+    over.strain = StrainKind::Shear;                                                       // as --strain shear
+    CHECK_NOTHROW(over.check());
     // A saved network brings its own box: generation keys beside it would be ignored.
     CHECK_THROWS_WITH(parse_scene("[network]\nfile = \"n.txt\"\npl = 0.2\n", "s.toml"),
                       Catch::Contains("[network].file = 'n.txt' is given with [network].pl"));

@@ -112,6 +112,11 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
         CHECK(slurp(tmpdir() + "/stderr").find(c.needle) != std::string::npos);
         CHECK(!exists(out + "/summary.json"));
     }
+    // A scene's fraction with --crossings fraction from the command line: the combination is checked with it in.
+    const std::string frac = tmpdir() + "/frac.toml";
+    write(frac, "[network]\nL = 2.5\nq = 5\n[wet]\nfraction = 0.5\nbeta = 0\n");
+    CHECK(run(frac + " --crossings fraction --no-moduli -q") == 0);
+    CHECK(run(frac + " --no-moduli -q") == 2);
     // An output directory that cannot be made (a file is in the way) is refused before any work.
     CHECK(run("--L 2.5 --q 5 --beta 0 -o " + law + "/sub") == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("cannot create the directory") != std::string::npos);

@@ -36,6 +36,12 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
     CHECK(parse_scene("", "empty.toml").wet.local_hops == ActiveSetOptions{}.local_hops);
     CHECK(parse_scene("", "empty.toml").wet.bundle_partners == ActiveSetOptions{}.bundle_partners);
     CHECK(parse_scene("[wet]\nbundle_partners = 2\n", "b.toml").wet.bundle_partners == 2);
+    // A fraction without crossings = fraction would be ignored: refused once overrides are in (--crossings fraction
+    // may still come from the command line).
+    Scene fr = parse_scene("[wet]\nfraction = 0.5\n", "fr.toml");
+    CHECK_THROWS_WITH(fr.check(), Catch::Contains("fr.toml: [wet].fraction = 0.5 is used only with crossings = fraction"));
+    fr.wet.crossings = "fraction";
+    CHECK_NOTHROW(fr.check());
     struct Bad {
         std::string toml, needle;
     };
@@ -55,7 +61,7 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
                          Bad{"[wet]\nlocal_threshold = 0\n", "[wet].local_threshold = 0"},
                          Bad{"[wet]\nlocal_hops = -1\n", "[wet].local_hops = -1"},
                          Bad{"[wet]\nbundle_partners = -1\n", "[wet].bundle_partners = -1"},
-                         Bad{"[wet]\nfraction = 0.5\n", "[wet].fraction = 0.5 is used only with crossings = fraction"},
+
                          Bad{"[wet]\nbundle_partners = 1.5\n", "[wet].bundle_partners"},
                          Bad{"[wet]\nlaw = \"/nonexistent/law.txt\"\n", "/nonexistent/law.txt"}}) {
         INFO(b.toml);

@@ -53,7 +53,8 @@ struct Scene {
     SolverSettings solver;
     WetSettings wet;
 
-    void check() const;  // throws InputError naming the bad value and the scene's source
+    void check() const;         // throws InputError naming the bad value and the scene's source
+    void check_values() const;  // each value alone (parse_scene); check() adds their combinations (load, wet fraction)
 };
 
 // Parses a TOML scene; unknown tables/keys and wrong types are InputErrors naming file and key.

@@ -40,8 +40,9 @@ namespace fibernet {
 
 struct WetEvents {
     int moves = 0, ruptures = 0, formed = 0, merged = 0, locked = 0;
-    // Aligned crossings and contacts left without a bridge by ActiveSetOptions::bundle_partners at one update (the
-    // same candidates are refused every round); a relaxation's result holds its last update's count, not a sum.
+    // Aligned segment pairs (crossing or in contact) left without a bridge by ActiveSetOptions::bundle_partners at one
+    // update (the same pairs are refused every round); a relaxation's result holds its last update's count, not a sum:
+    // the final global round's for a stable set (a local round's update sees only the region's segments).
     int capped = 0;
     int total() const { return moves + ruptures + formed + merged; }
 };
