@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 FN=${1:-build/fibernet}
 for spec in "4 0.6 3.16" "5 0.7 2.83" "6 0.8 2.58" "7 0.9 2.39" "8 1.0 2.24"; do
     set -- $spec
-    { "$FN" compare --open --q "$1" --pl "$2" --L "$3" --seed 1 --samples 40 | /usr/bin/python3 -c "
+    { "$FN" compare --open --q "$1" --pl "$2" --L "$3" --seed 1 --samples 40 -q | /usr/bin/python3 -c "
 import json, sys
 j = json.load(sys.stdin); g = j['gaps']
 print(f\"q=$1 pl=$2 L=$3: {j['agree']}/{j['networks']} agree; zero eigenvalues <= {g['largest_zero_eigenvalue']:.2e}, \"

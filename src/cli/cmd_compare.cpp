@@ -12,7 +12,6 @@
 
 namespace fibernet::cli {
 
-
 namespace {
 nlohmann::json row(std::uint64_t seed, const RigidityComparison& c) {
     return {{"seed", seed},
