@@ -4,9 +4,10 @@
 # density q, crosslink probability pl, beta and both discretizations, one after another, moduli off. Prints one line
 # per run: status, rounds (local), bridges initial -> final, bundles (largest; aligned bridges per segment of a
 # bundled fiber: how many other fibers' segments each lies along), solver iterations, seconds.
-#   bench/run_wet_robustness.sh [FIBERNET=build/fibernet] [OUT=/tmp/wet_robustness]
+#   bench/run_wet_robustness.sh [FIBERNET=build/fibernet] [OUT=/tmp/wet_robustness] [EXTRA=""]
+# EXTRA: more `fibernet wet` flags for every run, e.g. "--bundle-partners 2".
 set -euo pipefail
-FIBERNET=${1:-build/fibernet}; OUT=${2:-/tmp/wet_robustness}
+FIBERNET=${1:-build/fibernet}; OUT=${2:-/tmp/wet_robustness}; EXTRA=${3:-}
 mkdir -p "$OUT"
 #      L q  pl  beta scheme seed
 for cfg in "6 10 0.5 0.1 seed 1" "6 10 0.5 1 seed 2" "6 6 0.5 0.01 seed 3" "6 20 0.5 0.01 seed 4" \
@@ -17,7 +18,7 @@ for cfg in "6 10 0.5 0.1 seed 1" "6 10 0.5 1 seed 2" "6 6 0.5 0.01 seed 3" "6 20
   start=$(date +%s.%N)
   rc=0
   OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1} \
-    "$FIBERNET" wet --L "$1" --q "$2" --pl "$3" --beta "$4" --scheme "$5" --seed "$6" --no-moduli -q \
+    "$FIBERNET" wet --L "$1" --q "$2" --pl "$3" --beta "$4" --scheme "$5" --seed "$6" --no-moduli -q $EXTRA \
     > "$OUT/$name.json" 2> "$OUT/$name.err" || rc=$?
   secs=$(echo "$(date +%s.%N) - $start" | bc)
   /usr/bin/python3 - "$OUT/$name.json" "$name" "$rc" "$secs" <<'PY'
