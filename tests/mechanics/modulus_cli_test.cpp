@@ -90,6 +90,17 @@ TEST_CASE("cli modulus: a solver that does not converge exits 1 and prints no mo
     CHECK(j["stress"].is_null());
 }
 
+TEST_CASE("cli modulus: a failed linear solve on the seed scheme says so and names the way out", "[cli][modulus]") {
+    // docs/moduli.md, the limit: at L = 40 the seed scheme's 1e-6 segments leave the CG for G on round-off.
+    REQUIRE(run("modulus --L 40 --prune dangling ends -q") == 1);
+    const auto j = out();
+    CHECK(j["status"] == "modulus_failed");
+    CHECK(j["moduli"]["G"].is_null());
+    const std::string err = slurp(dir() + "/stderr");
+    CHECK(err.find("did not converge for G") != std::string::npos);
+    CHECK(err.find("--scheme even avoids them") != std::string::npos);
+}
+
 TEST_CASE("cli modulus: bad input exits 2", "[cli][modulus][input]") {
     CHECK(run("modulus --L 3 --q 8 --solver nope") == 2);
     CHECK(slurp(dir() + "/stderr").find("nope") != std::string::npos);
