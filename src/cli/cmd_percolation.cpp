@@ -49,9 +49,9 @@ using Key = std::tuple<std::string, std::string, int>;  // L, q as written, samp
 
 // Reads the rows of an existing CSV; lines that do not parse (an interrupted write) are skipped. Refuses rows that
 // this run's --pl and --seed would not have made: resuming them would mix two runs. seed_of(row) is the seed the
-// base seed gives for the row's L, q and sample, if the row is on this run's grid (a row off it, e.g. of an L left
-// out on resume, keeps its seed: its L and q are known only to the 10 digits written, which the seed's hash of the
-// exact values cannot be checked against).
+// base seed gives for the row's L, q and sample, where it can be known: on this run's grid, or off it (an L left out
+// on resume) when the row's L and q were written in under 10 significant digits, so their parsed values are exact
+// (the seed hashes the exact values; a value cut to 10 digits cannot be checked).
 std::vector<PercolationSample> read_rows(const std::string& path, double pl, std::uint64_t base_seed,
                                          const std::function<std::optional<std::uint64_t>(const PercolationSample&)>& seed_of,
                                          bool& ends_with_newline) {
@@ -171,10 +171,22 @@ void register_percolation(CLI::App& app) {
                 const double q = std::round((o->q_min + k * o->q_step) * 1e9) / 1e9;
                 grid[{fmt(L), fmt(q)}] = {L, q};
             }
+        auto short_text = [](double v) {  // fewer than 10 significant digits in the CSV: parsed back exactly
+            int digits = 0;
+            bool leading = true;
+            for (char ch : fmt(v)) {
+                if (ch == 'e' || ch == 'E') break;
+                if (ch < '0' || ch > '9') continue;
+                if (leading && ch == '0') continue;
+                leading = false, ++digits;
+            }
+            return digits < 10;
+        };
         auto seed_of = [&](const PercolationSample& r) -> std::optional<std::uint64_t> {
             auto it = grid.find({fmt(r.L), fmt(r.q)});
-            if (it == grid.end()) return std::nullopt;
-            return percolation_seed(o->seed, it->second.first, it->second.second, r.sample);
+            if (it != grid.end()) return percolation_seed(o->seed, it->second.first, it->second.second, r.sample);
+            if (short_text(r.L) && short_text(r.q)) return percolation_seed(o->seed, r.L, r.q, r.sample);
+            return std::nullopt;
         };
         std::vector<PercolationSample> rows;
         bool newline = true;

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -124,10 +125,15 @@ Checkpoint read_checkpoint(const std::string& path, const nlohmann::json& params
     for (auto it = recorded.begin(); it != recorded.end(); ++it)  // e.g. a network file against a generated network
         if (!params.contains(it.key()))
             fail(it.key() + " = " + shown(it.value()) + " is not a parameter of this run" + flag_of(it.key()));
+    // `completed` (0 or 1) before dofs; a checkpoint written without it is an unfinished one.
     int done = 0;
-    if (!(is >> key >> done) || key != "completed" || (done != 0 && done != 1)) fail("missing completed");
+    if (!(is >> key)) fail("missing dofs");
+    if (key == "completed") {
+        if (!(is >> done) || (done != 0 && done != 1)) fail("completed must be 0 or 1");
+        if (!(is >> key)) fail("missing dofs");
+    }
     c.completed = done == 1;
-    if (!(is >> key >> c.dofs) || key != "dofs" || c.dofs < 0) fail("missing dofs");
+    if (key != "dofs" || !(is >> c.dofs) || c.dofs < 0) fail("missing dofs");
     if (!(is >> key >> c.rows) || key != "rows") fail("missing rows");
     if (!(is >> key >> s.step) || key != "step") fail("missing step");
     if (!(is >> key >> s.t) || key != "t") fail("missing t");
@@ -166,7 +172,8 @@ void register_sweep(CLI::App& app) {
     cmd->add_option("--max-step", p->max_step, "largest step (default 0.05)");
     cmd->add_option("-o,--output", *out, "CSV file, one row per accepted step (an existing one is replaced, unless --resume)")
         ->required();
-    cmd->add_option("--checkpoint", *ckpt, "checkpoint file (default OUTPUT.ckpt); an existing one needs --resume");
+    cmd->add_option("--checkpoint", *ckpt,
+                    "checkpoint file (default OUTPUT.ckpt); one of an interrupted or failed sweep needs --resume");
     cmd->add_flag("--resume", *resume, "continue an interrupted sweep from its checkpoint (same parameters only)");
     cmd->add_flag("-q,--quiet", *quiet, "no progress lines on stderr");
     // A sweep's strain comes from --gamma-max: hide the scene flag --gamma (kept registered, so that giving it
@@ -184,7 +191,8 @@ void register_sweep(CLI::App& app) {
         std::error_code ec;
         if (!*resume && std::filesystem::is_regular_file(*ckpt, ec) && !completed_checkpoint(*ckpt))
             throw InputError("command line: --checkpoint '" + *ckpt +
-                             "' exists (an unfinished sweep); add --resume to continue it, or remove it");
+                             "' exists (an interrupted or failed sweep); add --resume to continue it with the same "
+                             "parameters, or remove it");
         const nlohmann::json params = sweep_parameters(s, *p);
         Checkpoint c;
         if (*resume) c = read_checkpoint(*ckpt, params);  // before any work: a mismatch costs nothing
@@ -206,9 +214,13 @@ void register_sweep(CLI::App& app) {
                                  std::to_string(e.num_dofs()));
             rows = c.rows;
             truncate_csv(*out, rows);
-            std::cerr << "sweep: resuming at step " << start.step << ", gamma = " << start.t << "\n";
+            if (!*quiet)
+                std::cerr << (c.completed ? "sweep: the checkpoint's sweep is complete; nothing to add\n"
+                                          : "sweep: resuming at step " + std::to_string(start.step) + ", gamma = " +
+                                                show(start.t) + "\n");
         } else {
             write_file_atomic(*out, std::string(kHeader) + "\n");
+            std::remove(ckpt->c_str());  // a completed sweep's checkpoint must not outlive a new run that fails early
         }
         std::ofstream csv(*out, std::ios::app);
         if (!csv) throw InputError("cannot append to '" + *out + "'");

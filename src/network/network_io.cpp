@@ -181,7 +181,10 @@ Network read_network(std::istream& is, const std::string& source) {
                             {k, static_cast<long>(r.line)}});
         }
         std::sort(keys.begin(), keys.end());
-        const auto rep = std::adjacent_find(keys.begin(), keys.end(), [](const auto& a, const auto& b) { return a.first == b.first; });
+        // Of all repeats, the one whose later line comes first in the file.
+        auto rep = keys.end();
+        for (auto it = keys.begin(); it + 1 < keys.end(); ++it)
+            if (it->first == (it + 1)->first && (rep == keys.end() || (it + 1)->second[0] < (rep + 1)->second[0])) rep = it;
         if (rep != keys.end()) {
             const long first = rep->second[0], later = std::next(rep)->second[0];
             r.line = static_cast<int>(std::next(rep)->second[1]);  // the message names the later line

@@ -43,6 +43,10 @@ TEST_CASE("cli percolation: --resume refuses samples of another --seed", "[cli][
     CHECK(run(base + " --samples 3 --resume") == 2);  // the default --seed 1 is another seed too
     REQUIRE(run(base + " --samples 3 --seed 3 --resume") == 0);
     CHECK(slurp(csv).size() > rows.size());
+    // Rows of an L that this run leaves out are still checked (their L and q are exact in the CSV).
+    const std::string other = "percolation --pl 1 --L 4 --q-min 4 --q-max 5 --q-step 1 --samples 2 --out " + csv;
+    CHECK(run(other + " --seed 8 --resume") == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("is not the seed --seed 8 gives") != std::string::npos);
 }
 
 TEST_CASE("cli compare: --out is checked first; progress per network on stderr, -q silences it", "[cli][compare]") {

@@ -103,8 +103,13 @@ TEST_CASE("cli sweep: an unfinished sweep's checkpoint needs --resume; a complet
     ck.replace(ck.find("\ncompleted 1\n"), 13, "\ncompleted 0\n");
     write(csv + ".ckpt", ck);
     CHECK(run(net + csv) == 2);
-    CHECK(slurp(tmpdir() + "/stderr").find("add --resume to continue it, or remove it") != std::string::npos);
+    CHECK(slurp(tmpdir() + "/stderr").find("(an interrupted or failed sweep); add --resume to continue it with the same parameters, or remove it") != std::string::npos);
     CHECK(slurp(csv) == rows2);
+    // A checkpoint without the completed line (written before it existed) reads as unfinished: --resume works.
+    ck.replace(ck.find("\ncompleted 0\n"), 13, "\n");
+    write(csv + ".ckpt", ck);
+    CHECK(run(net + csv + " --resume") == 0);
+    CHECK(untimed(slurp(csv)) == untimed(rows2));
     CHECK(run("sweep --help") == 0);
     CHECK(slurp(tmpdir() + "/stdout").find("replaced") != std::string::npos);
 }

@@ -68,5 +68,11 @@ TEST_CASE("network io: malformed files are rejected with file, line and value", 
     // A repeated crossing (either fiber order) would count twice.
     expect_error(replace(valid(), "crossings 1\n0 1 0.5 0.5 0 0 1\n", "crossings 2\n0 1 0.5 0.5 0 0 1\n1 0 0.5 0.5 0 0 1\n"),
                  "net.txt:8: crossing 1 repeats crossing 0 (fibers 0 and 1)");
+    // Of two repeats, the one met first in the file is named (not the first in fiber order).
+    const std::string three = "fibernet-network 1\nbox 10 open\nfibers 3\n0 0 0 1\n0.5 -0.5 1.5707963267948966 1\n"
+                              "0.2 -0.5 1.5707963267948966 1\ncrossings 4\n1 2 0.5 0.5 0 0 1\n0 2 0.2 0.5 0 0 1\n"
+                              "0 2 0.2 0.5 0 0 1\n0 1 0.5 0.5 0 0 1\n";
+    expect_error(replace(replace(three, "1 2 0.5 0.5 0 0 1\n", "0 1 0.5 0.5 0 0 1\n"), "crossings 4\n", "crossings 4\n"),
+                 "net.txt:10: crossing 2 repeats crossing 1 (fibers 0 and 2)");
     CHECK_THROWS_AS(load_network("/nonexistent/file.txt"), InputError);
 }
