@@ -71,11 +71,7 @@ void register_compare(CLI::App& app) {
             Scene si = s;
             si.mikado.seed = s.mikado.seed + static_cast<std::uint64_t>(i);
             const Network net = scene_network(si);
-            if (net.periodic)
-                throw InputError(s.source + ": the box is periodic; the comparison needs an open box (" +
-                                 (s.network_file.empty() ? std::string("add --open")
-                                                         : "the network file '" + s.network_file + "' has a periodic box") +
-                                 ")");
+            refuse_periodic(s, net, "the comparison needs an open box");
             const long coords = static_cast<long>(discretize(net, si.discretization).x.size());
             if (coords > *max_dofs)
                 throw InputError(s.source + ": the model has " + std::to_string(coords) + " coordinates, more than --max-dofs " +

@@ -125,12 +125,11 @@ void register_modulus(CLI::App& app) {
                      {"total", seconds_since(t_all)}}}});
         progress.line(ok ? "done" : conv ? "the linear moduli failed (status modulus_failed)" : "not converged", t_all);
         // A hint even with -q (the run failed), only for the CG's round-off stop (not a saddle or an unstable state).
-        if (conv && !ok && s.discretization.scheme == Scheme::Seed && !lin.is_null() &&
-            lin["message"].get<std::string>().find("conjugate gradients") != std::string::npos)
+        const std::string why = lin.is_null() ? std::string() : lin["message"].get<std::string>();
+        if (conv && !ok && s.discretization.scheme == Scheme::Seed && why.find("conjugate gradients") != std::string::npos)
             std::fprintf(stderr, "modulus: %s; the seed scheme's very short segments (shortest %.2g seed units here) make "
                                  "H ill-conditioned on large networks: --scheme even avoids them (docs/moduli.md)\n",
-                         lin["message"].get<std::string>().c_str(),
-                         summarize(m).shortest_segment);
+                         why.c_str(), summarize(m).shortest_segment);
         if (!ok) exit_code() = 1;
     });
 }

@@ -28,7 +28,6 @@
 
 namespace fibernet::cli {
 
-
 namespace {
 const char* kHeader = "pl,L,q,sample,seed,fibers,d,rigid_spanning,connected_spanning,seconds";
 
@@ -166,11 +165,9 @@ void register_percolation(CLI::App& app) {
         // 10 digits written lost some.
         std::map<std::pair<std::string, std::string>, std::pair<double, double>> grid;
         const int nq = static_cast<int>(std::floor((o->q_max - o->q_min) / o->q_step + 1e-9)) + 1;
+        auto q_at = [&](int k) { return std::round((o->q_min + k * o->q_step) * 1e9) / 1e9; };  // the k-th density
         for (double L : o->L)
-            for (int k = 0; k < nq; ++k) {
-                const double q = std::round((o->q_min + k * o->q_step) * 1e9) / 1e9;
-                grid[{fmt(L), fmt(q)}] = {L, q};
-            }
+            for (int k = 0; k < nq; ++k) grid[{fmt(L), fmt(q_at(k))}] = {L, q_at(k)};
         auto short_text = [](double v) {  // fewer than 10 significant digits in the CSV: parsed back exactly
             int digits = 0;
             bool leading = true;
@@ -206,7 +203,7 @@ void register_percolation(CLI::App& app) {
         std::vector<Item> todo;
         for (double L : o->L)
             for (int k = 0; k < nq; ++k) {
-                const double q = std::round((o->q_min + k * o->q_step) * 1e9) / 1e9;
+                const double q = q_at(k);
                 for (int s = 0; s < o->samples; ++s)
                     if (!done.count({fmt(L), fmt(q), s})) todo.push_back({L, q, s});
             }

@@ -14,7 +14,6 @@
 
 namespace fibernet::cli {
 
-
 namespace {
 nlohmann::json counts(const RigidityResult& r) {
     nlohmann::json j = {{"bodies", r.bodies},
@@ -57,11 +56,7 @@ void register_rigidity(CLI::App& app) {
         auto t0 = std::chrono::steady_clock::now();
         const Network net = scene_network(s);
         const double t_net = seconds_since(t0);
-        if (net.periodic)
-            throw InputError(s.source + ": the box is periodic; rigidity counts open boxes with clamps (" +
-                             (s.network_file.empty() ? std::string("add --open")
-                                                     : "the network file '" + s.network_file + "' has a periodic box") +
-                             ")");
+        refuse_periodic(s, net, "rigidity counts open boxes with clamps");
         t0 = std::chrono::steady_clock::now();
         const RigidityResult open = analyze_rigidity(body_pin_framework(net));
         const double t_open = seconds_since(t0);

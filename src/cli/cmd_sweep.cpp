@@ -16,6 +16,7 @@
 #include "fibernet/mechanics/sweep.hpp"
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/util/error.hpp"
+#include "fibernet/util/hash.hpp"
 
 namespace fibernet::cli {
 
@@ -41,8 +42,8 @@ nlohmann::json sweep_parameters(const Scene& s, const SweepParams& p) {
     nlohmann::json j = scene_parameters(s);
     if (!s.network_file.empty()) {  // the file's content, not only its name, makes the network
         std::ifstream is(s.network_file, std::ios::binary);
-        std::uint64_t h = 1469598103934665603ull;  // FNV-1a
-        for (char c; is.get(c);) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+        std::uint64_t h = kFnvOffset;
+        for (char c; is.get(c);) h = fnv1a(h, static_cast<unsigned char>(c));
         j["network_file_fnv1a"] = h;
         // The file by its canonical path: the same file named from another directory or as ./x.net is the same sweep.
         std::error_code ec;

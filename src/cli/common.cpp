@@ -65,10 +65,11 @@ void check_outputs(const std::vector<std::pair<std::string, std::string>>& outpu
         files.push_back({flag, p});
         // The probe where write_file_atomic puts its temporary: beside the path as given (a symlinked file's own
         // directory, not its target's).
-        std::string probe = (fs::absolute(path).parent_path() / ".fibernet-probe-XXXXXX").string();
+        const fs::path dir = fs::absolute(path).parent_path();
+        std::string probe = (dir / ".fibernet-probe-XXXXXX").string();
         const int fd = mkstemp(probe.data());
         if (fd < 0)
-            throw InputError(what + ": cannot create a file in directory '" + p.parent_path().string() + "' (" +
+            throw InputError(what + ": cannot create a file in directory '" + dir.string() + "' (" +
                              std::strerror(errno) + ")");
         close(fd);
         unlink(probe.c_str());
@@ -208,6 +209,14 @@ nlohmann::json scene_parameters(const Scene& s) {
     j["scheme"] = to_string(s.discretization.scheme);
     j["n_seg"] = s.discretization.n_seg, j["h"] = s.discretization.h, j["a"] = s.discretization.aspect_ratio;
     return j;
+}
+
+void refuse_periodic(const Scene& s, const Network& net, const std::string& needs) {
+    if (!net.periodic) return;
+    throw InputError(s.source + ": the box is periodic; " + needs + " (" +
+                     (s.network_file.empty() ? std::string("add --open")
+                                             : "the network file '" + s.network_file + "' has a periodic box") +
+                     ")");
 }
 
 void refuse_trimmed_ends(const Scene& s, const std::string& command, const std::string& why) {

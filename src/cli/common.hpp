@@ -56,6 +56,10 @@ void check_outputs(const std::vector<std::pair<std::string, std::string>>& outpu
 // A seed option's check: CLI11 wraps "-1" and saturates values past 2^64 - 1 into a uint64; digits in range only.
 CLI::Validator seed_check();
 
+// Commands that need an open box (clamps) refuse a periodic network; the message says what to change: --open for a
+// generated network, or that the network file's box is periodic.
+void refuse_periodic(const Scene& s, const Network& net, const std::string& needs);
+
 // Commands whose physics acts on fiber end arms (bridges, clamps, rods) refuse `prune ends` with an InputError.
 void refuse_trimmed_ends(const Scene& s, const std::string& command, const std::string& why);
 

@@ -16,6 +16,7 @@
 #include <set>
 #include <utility>
 
+#include "fibernet/util/hash.hpp"
 #include "fibernet/util/parallel.hpp"
 #include "fibernet/wet/wet_region.hpp"
 #include "fibernet/wet/wetting.hpp"
@@ -468,9 +469,9 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
     using Signature = std::vector<std::array<int, 7>>;
     constexpr size_t kKeep = 16;
     auto hash_of = [](const Signature& sg) {
-        std::uint64_t h = 1469598103934665603ull;  // FNV-1a
+        std::uint64_t h = kFnvOffset;
         for (const auto& a : sg)
-            for (int v : a) h = (h ^ static_cast<std::uint32_t>(v)) * 1099511628211ull;
+            for (int v : a) h = fnv1a(h, static_cast<std::uint32_t>(v));
         return h;
     };
     std::vector<Signature> history{signature(bridges)};
