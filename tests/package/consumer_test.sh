@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# The installed package works for a project of its own: `cmake --install` into a scratch prefix, examples/ built
+# against it with find_package(fibernet), and the example's shear modulus equal to the installed CLI's for the same
+# network (both are the library's linear_moduli at the same Newton equilibrium).
+#   consumer_test.sh <fibernet build dir> <fibernet source dir>
+set -euo pipefail
+build=$(cd "$1" && pwd); src=$(cd "$2" && pwd)
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+cmake --install "$build" --prefix "$tmp/prefix" > "$tmp/install.log" || { cat "$tmp/install.log"; fail "cmake --install"; }
+libdir=$(ls -d "$tmp"/prefix/lib*/cmake/fibernet 2>/dev/null | head -1)
+for f in bin/fibernet include/fibernet/mechanics/moduli.hpp include/fibernet/wet/wet_run.hpp; do
+  [ -e "$tmp/prefix/$f" ] || fail "not installed: $f"
+done
+[ -n "$libdir" ] && [ -f "$libdir/fibernetConfig.cmake" ] || fail "no fibernetConfig.cmake under $tmp/prefix/lib*/cmake/fibernet"
+
+cmake -S "$src/examples" -B "$tmp/examples" -DCMAKE_PREFIX_PATH="$tmp/prefix" > "$tmp/configure.log" 2>&1 \
+  || { cat "$tmp/configure.log"; fail "find_package(fibernet) from the installed prefix"; }
+cmake --build "$tmp/examples" > "$tmp/build.log" 2>&1 || { cat "$tmp/build.log"; fail "building examples/"; }
+
+args=(--L 5 --q 8 --pl 1 --seed 1 --gamma 0.01)
+out=$("$tmp/examples/shear_modulus" 5 8 1 1 0.01) || fail "shear_modulus exited $?"
+echo "example: $out"
+cli=$("$tmp/prefix/bin/fibernet" modulus "${args[@]}" --scheme seed --a 10 --tol 1e-10 -q)
+python3 - "$out" "$cli" <<'PY' || fail "the example's modulus differs from the CLI's"
+import json, sys
+words = sys.argv[1].split()
+ex = {words[i]: words[i + 1] for i in range(0, len(words) - 1, 2)}
+G, Ga = float(ex["G"]), float(ex["G_affine"])
+m = json.loads(sys.argv[2])["moduli"]
+print(f"CLI: G {m['G']!r} G_affine {m['G_affine']!r}")
+tol = 1e-8 * abs(m["G"]) + 2 * m["G_error"]
+assert m["G"] > 0 and abs(G - m["G"]) <= tol, (G, m["G"], tol)
+assert abs(Ga - m["G_affine"]) <= 1e-9 * abs(Ga), (Ga, m["G_affine"])
+PY
+
+# Bad input through the library: InputError names the value, the example exits 2.
+set +e
+msg=$("$tmp/examples/shear_modulus" 5 8 1.5 2>&1); rc=$?
+set -e
+[ "$rc" = 2 ] || fail "pl = 1.5: exit $rc, expected 2"
+echo "$msg" | grep -q "1.5" || fail "pl = 1.5: message does not name the value: $msg"
+echo "package test passed"
