@@ -85,13 +85,15 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     // little), made consistent with the geometry before the first solve.
     run.initial_bridges = wet_crossings(net, m, dry.positions(run.dry.q, F), B, opt.rule);
     std::vector<Bridge> bridges = run.initial_bridges;
-    ActiveSetOptions first = opt.active_set;
+    ActiveSetOptions options = opt.active_set;
+    if (opt.rule.which != WetWhich::All) options.dry_pairs = std::make_shared<const FiberPairs>(dry_pairs(net, opt.rule));
+    ActiveSetOptions first = options;
     first.form_new = false;
     update_bridges(dry, run.dry.q, F, bridges, first);
     run.wet.q = run.dry.q;
     // Rounds are capped in Newton iterations (active_set.hpp); first-order solvers' iterations are cheap and many.
     // Local rounds were designed and measured with Newton (docs/wet.md, "Local rounds"): other solvers solve globally.
-    ActiveSetOptions as = opt.active_set;
+    ActiveSetOptions as = options;
     if (opt.solver != "newton") as.round_iterations = 0, as.local_fraction = 0;
     run.active = relax_wet(dry, F, opt.params, bridges, *solver, run.wet.q, as);
     run.seconds_wet_solve = run.active.seconds_solve;

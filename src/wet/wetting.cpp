@@ -40,16 +40,33 @@ int home_segment(const FiberChain& ch, double s) {
 }
 }  // namespace
 
+std::vector<char> wet_choice(const Network& net, const WettingRule& rule) {
+    std::vector<char> wet(net.crossings.size(), 1);
+    Rng rng(derive_seed(rule.seed, 0x77e7));
+    for (size_t k = 0; k < net.crossings.size(); ++k) {
+        const double u = rng.uniform();  // drawn for every crossing so the choice of one does not shift the others
+        if (rule.which == WetWhich::Free && net.crossings[k].crosslink) wet[k] = 0;
+        if (rule.which == WetWhich::Fraction && !(u < rule.fraction)) wet[k] = 0;
+    }
+    return wet;
+}
+
+FiberPairs dry_pairs(const Network& net, const WettingRule& rule) {
+    FiberPairs out;
+    const std::vector<char> wet = wet_choice(net, rule);
+    for (size_t k = 0; k < net.crossings.size(); ++k)
+        if (!wet[k]) out.insert({std::min(net.crossings[k].f1, net.crossings[k].f2), std::max(net.crossings[k].f1, net.crossings[k].f2)});
+    return out;
+}
+
 std::vector<Bridge> wet_crossings(const Network& net, const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
                                   const WettingRule& rule) {
     std::vector<Bridge> out;
-    Rng rng(derive_seed(rule.seed, 0x77e7));
+    const std::vector<char> wet = wet_choice(net, rule);
     const double unit = m.fiber_length;  // network lengths are in fiber lengths
     for (size_t k = 0; k < net.crossings.size(); ++k) {
         const Crossing& c = net.crossings[k];
-        const double u = rng.uniform();  // drawn for every crossing so the choice of one does not shift the others
-        if (rule.which == WetWhich::Free && c.crosslink) continue;
-        if (rule.which == WetWhich::Fraction && !(u < rule.fraction)) continue;
+        if (!wet[k]) continue;
         const FiberChain &c1 = m.chains[c.f1], &c2 = m.chains[c.f2];
         int k1 = home_segment(c1, c.s1 * unit), k2 = home_segment(c2, c.s2 * unit);
         const int node = k < m.crossing_node.size() ? m.crossing_node[k] : -1;

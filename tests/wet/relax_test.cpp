@@ -5,6 +5,8 @@
 #include "fibernet/mechanics/equilibrium.hpp"  // affine_start
 #include "fibernet/solve/newton.hpp"
 #include "fibernet/wet/active_set.hpp"
+#include "fibernet/wet/wet_run.hpp"
+#include "fibernet/wet/wetting.hpp"
 #include "wet_fixtures.hpp"
 
 using namespace fibernet;
@@ -137,4 +139,79 @@ TEST_CASE("wet relaxation: Newton's LDL^T rung only under capillary load, and on
             for (bool l : s.ldl) CHECK(l == (use && beta > 0));  // beta = 0 stays the dry solve, bit for bit
             CHECK(!s.options().ldl);
         }
+}
+
+TEST_CASE("wet relaxation: crossings the wetting rule leaves dry stay dry", "[wet][relax]") {
+    // Before, the first update gave every free crossing a bridge again (fraction 0 at beta = 0 ended with a bridge on
+    // each of them), since it had no record of which crossings the rule had left dry.
+    const Network net = mikado(3.0, 10, 0.5, 2);
+    const Model m = model_of(net, 10);
+    NetworkEnergy e(m);
+    for (const WetWhich which : {WetWhich::Fraction, WetWhich::Free}) {
+        for (const double fraction : {0.0, 0.5}) {
+            if (which == WetWhich::Free && fraction > 0) continue;
+            WettingRule rule;
+            rule.which = which, rule.fraction = fraction, rule.seed = 3;
+            const FiberPairs dry = dry_pairs(net, rule);
+            const auto initial = wet_crossings(net, m, m.x, m.box.B0(), rule);
+            INFO(to_string(which) << " " << fraction << ": " << dry.size() << " dry pairs, " << initial.size()
+                                  << " initial bridges of " << net.crossings.size() << " crossings");
+            REQUIRE(dry.size() > 10);
+            CHECK(initial.size() + dry.size() >= net.crossings.size() - 2);  // a pair may cross twice (images)
+            for (const Bridge& b : initial) CHECK(dry.count({b.f1, b.f2}) == 0);
+            // One update with new bridges allowed, as after a round: none forms between a dry pair.
+            ActiveSetOptions opt;
+            opt.dry_pairs = std::make_shared<const FiberPairs>(dry);
+            std::vector<Bridge> b = initial;
+            update_bridges(e, e.dofs(m.x), Eigen::Matrix2d::Identity(), b, opt);
+            int on_dry = 0;
+            for (const Bridge& x : b) on_dry += static_cast<int>(dry.count({x.f1, x.f2}));
+            CHECK(on_dry == 0);
+            // Without the record, the same update wets most of them again.
+            std::vector<Bridge> open = initial;
+            update_bridges(e, e.dofs(m.x), Eigen::Matrix2d::Identity(), open, ActiveSetOptions{});
+            int reopened = 0;
+            for (const Bridge& x : open) reopened += static_cast<int>(dry.count({x.f1, x.f2}));
+            CHECK(reopened > (which == WetWhich::Fraction ? static_cast<int>(dry.size()) / 2 : 0));  // free: contacts
+        }
+    }
+    // The whole run: at beta > 0 no dry pair holds a bridge at the end either.
+    WetRunOptions opt;
+    opt.params.beta = 0.05;
+    opt.moduli = false;
+    opt.rule.which = WetWhich::Fraction, opt.rule.fraction = 0.5, opt.rule.seed = 3;
+    opt.solver_options.tol = 1e-9;
+    const WetRun run = run_wet(net, m, Eigen::Matrix2d::Identity(), opt);
+    INFO(run.active.message);
+    CHECK(run.active.stable);
+    const FiberPairs dry = dry_pairs(net, opt.rule);
+    int on_dry = 0;
+    for (const Bridge& x : run.active.bridges) on_dry += static_cast<int>(dry.count({x.f1, x.f2}));
+    CHECK(on_dry == 0);
+    CHECK(run.active.events.formed > 0);  // new crossings and contacts of other pairs still get bridges
+}
+
+TEST_CASE("wet relaxation: a solve that uses its whole iteration budget without changing the set ends unconverged",
+          "[wet][relax]") {
+    // L-BFGS with a small budget on a network it cannot settle in that many iterations: before, every round ran its
+    // max_iter again with the set unchanged, towards max_rounds (239 rounds of 500 iterations on a 90-fiber network).
+    const Network net = mikado(3.0, 10, 0.5, 2);
+    const Model m = model_of(net, 10);
+    NetworkEnergy e(m);
+    SolverOptions so;
+    so.tol = 1e-10, so.max_iter = 20;
+    auto lbfgs = make_solver("lbfgs", so);
+    WetParams p;
+    p.beta = 0.01;
+    Eigen::VectorXd q = e.dofs(m.x);
+    ActiveSetOptions opt;
+    opt.round_iterations = 0, opt.local_fraction = 0;  // as run_wet sets them for first-order solvers
+    opt.max_rounds = 200;
+    const ActiveSetResult r = relax_wet(e, Eigen::Matrix2d::Identity(), p, wet_crossings(net, m, m.x, m.box.B0(), {}),
+                                        *lbfgs, q, opt);
+    INFO(r.message << " after " << r.rounds << " rounds");
+    CHECK(!r.stable);
+    CHECK(!r.last.converged());
+    CHECK(r.rounds < opt.max_rounds);
+    CHECK(r.message.find("iteration limit") != std::string::npos);
 }

@@ -28,6 +28,7 @@
 // where nodes moved. The whole network's gradient is checked after every round, and only a global round declares the
 // set stable (a local round at an equilibrium, or one that changes nothing, hands the next round to the whole network).
 #include <Eigen/Core>
+#include <memory>
 #include <set>
 #include <string>
 #include <utility>
@@ -82,10 +83,10 @@ struct ActiveSetOptions {
     // 2: a flat ribbon (each fiber between two neighbours); 6: a close-packed 3D bundle. 0: no cap (2D stacking
     // unbounded: a bundle of k fibers on one line holds k(k-1)/2 adhering pairs; docs/wet.md, "Bundle partners").
     int bundle_partners = 0;
+    // Fiber pairs whose network crossing the wetting rule left dry (wetting.hpp, dry_pairs): no bridge of any kind
+    // forms between them, since their crossing moves with the fibers and stays dry. Null: every crossing is wet.
+    std::shared_ptr<const FiberPairs> dry_pairs;
 };
-
-// Fiber pairs (lower index first).
-using FiberPairs = std::set<std::pair<int, int>>;
 
 struct ActiveSetResult {
     std::vector<Bridge> bridges;   // the final set

@@ -28,12 +28,17 @@
 // ruptures when the pair loses contact. Zipped segment pairs get locked bridges of their own, one per segment, so a
 // bundle holds one bridge per segment pair and adheres with -beta per unit overlap (issue 6).
 #include <Eigen/Core>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "fibernet/energy/capillary.hpp"
 #include "fibernet/model/model.hpp"
 
 namespace fibernet {
+
+// Fiber pairs (lower index first).
+using FiberPairs = std::set<std::pair<int, int>>;
 
 struct Bridge {
     int f1 = 0, f2 = 0;  // fibers, f1 != f2

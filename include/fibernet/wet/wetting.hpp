@@ -27,6 +27,15 @@ struct WettingRule {
 Bridge make_bridge(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B, int f1, int k1, int f2, int k2,
                    int crossing = -1);
 
+// Which network crossings the rule wets (one flag per crossing of net.crossings). Fraction draws one number per
+// crossing from `seed` in crossing order (reproducible; the choice of one does not shift the others).
+std::vector<char> wet_choice(const Network& net, const WettingRule& rule);
+
+// The fiber pairs of the crossings the rule leaves dry. A crossing moves with its fibers, so a dry one stays dry:
+// the active set forms no bridge between such a pair (ActiveSetOptions::dry_pairs); without this, the first update
+// gave every free crossing a bridge again, whatever the fraction.
+FiberPairs dry_pairs(const Network& net, const WettingRule& rule);
+
 // One bridge per wet network crossing, on the segments that contain it (a crosslink's supernode starts both homes),
 // at node positions x. Crossings are drawn for WetWhich::Fraction from `seed` in crossing order (reproducible).
 std::vector<Bridge> wet_crossings(const Network& net, const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
