@@ -572,7 +572,8 @@ int main(int argc, char** argv) {
                             DiscretizationParams dp;
                             dp.scheme = parse_scheme(sc), dp.aspect_ratio = a;
                             // DOF without pruning, for the record only.
-                            const int dof_full = NetworkEnergy(discretize(make_network(c.L, q, seed, {}), dp)).num_dofs();
+                            const Model full = discretize(make_network(c.L, q, seed, {}), dp);
+                            const int dof_full = NetworkEnergy(full).num_dofs();
                             dp.trim_ends = pruning.ends;
                             const Network net = make_network(c.L, q, seed, pruning);
                             const Model model = discretize(net, dp);

@@ -83,7 +83,9 @@ void register_modulus(CLI::App& app) {
             if (s.strain != StrainKind::Shear) modes.push_back(path_mode(s.strain, st.area));
             ModuliInfo info;
             auto* newton = dynamic_cast<NewtonSolver*>(solver.get());  // reuse its symbolic analysis
-            const auto mods = linear_moduli(e, eq.q, F, modes, {}, &info, newton ? newton->factorization() : nullptr);
+            ModuliOptions mo;
+            mo.equilibrium_tol = std::max(mo.equilibrium_tol, s.solver.tol);  // what the solver accepted
+            const auto mods = linear_moduli(e, eq.q, F, modes, mo, &info, newton ? newton->factorization() : nullptr);
             moduli = nlohmann::json::object();
             for (const auto& M : mods) {
                 ok = ok && M.ok;

@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 
 #include "fibernet/energy/bend.hpp"
 #include "fibernet/energy/sparse_pattern.hpp"
@@ -111,7 +112,17 @@ Eigen::VectorXd NetworkEnergy::dofs(const Eigen::VectorXd& x) const {
     return q;
 }
 
+namespace {
+// Eigen checks no sizes with NDEBUG: a q of another model would read past its end.
+void check_size(const Eigen::VectorXd& q, int ndof, const char* where) {
+    if (q.size() != ndof)
+        throw std::invalid_argument(std::string(where) + ": q has " + std::to_string(q.size()) +
+                                    " coordinates, the model " + std::to_string(ndof) + " free ones");
+}
+}  // namespace
+
 Eigen::VectorXd NetworkEnergy::positions(const Eigen::VectorXd& q, const Eigen::Matrix2d& F) const {
+    check_size(q, ndof_, "NetworkEnergy::positions");
     Eigen::VectorXd x(dof_.size());
     for (int i = 0; i < model_.num_nodes(); ++i) {
         if (dof_[2 * i] >= 0) {
@@ -133,6 +144,7 @@ Eigen::VectorXd NetworkEnergy::affine_map(const Eigen::VectorXd& q, const Eigen:
 
 Eigen::VectorXd NetworkEnergy::displacements(const Eigen::VectorXd& q, const Eigen::Matrix2d& F) const {
     // u = x - x_ref: q for free nodes, (F - I) x_ref for fixed ones.
+    check_size(q, ndof_, "NetworkEnergy::displacements");
     Eigen::VectorXd u(dof_.size());
     const Eigen::Matrix2d FmI = F - Eigen::Matrix2d::Identity();
     for (int i = 0; i < model_.num_nodes(); ++i) {

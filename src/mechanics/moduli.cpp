@@ -11,6 +11,7 @@
 
 #include "fibernet/mechanics/equilibrium.hpp"
 #include "fibernet/solve/cholmod_llt.hpp"
+#include "fibernet/solve/newton.hpp"  // roundoff_floor
 
 namespace fibernet {
 
@@ -48,14 +49,34 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
     auto t0 = Clock::now();
     Eigen::SparseMatrix<double> H = e.hessian_pattern();
     EnergyEval ev;
+    double gmax = 0;
     for (size_t m = 0; m < modes.size(); ++m) {
         const bool first = m == 0;
-        e.evaluate(q, F, modes[m].dF, kStrain | (first ? kHessian : 0u), ev, first ? &H : nullptr);
+        e.evaluate(q, F, modes[m].dF, kStrain | (first ? kHessian | kGradient : 0u), ev, first ? &H : nullptr);
+        if (first && n > 0) gmax = ev.gradient.cwiseAbs().maxCoeff();
         out[m].name = modes[m].name;
         out[m].E_tt = ev.d2E_dt2;
         b[m] = ev.d2E_dqdt;
     }
     inf.seconds_assembly = since(t0);
+    // The formula holds at an equilibrium only (E_xt in range(H)); elsewhere it returns a plausible number with a
+    // bound that says nothing (Newton stopped 4 iterations early on problems/default.toml at gamma = 0.01 gave G 1.4 %
+    // off with a bound of 3e-10). Accepted: max|g| within equilibrium_tol or the coordinates' round-off floor, where
+    // Newton itself stops.
+    const double floor = n > 0 ? roundoff_floor(H, q) : 0.0;
+    const bool equilibrium = !(gmax > std::max(opt.equilibrium_tol, floor));  // NaN: not an equilibrium either
+    if (!equilibrium) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "not an equilibrium: max|g| = %.3g above max(equilibrium_tol %.3g, round-off floor %.3g); linear "
+                      "moduli hold at an equilibrium only",
+                      gmax, opt.equilibrium_tol, floor);
+        for (auto& M : out) M.value = M.error = std::numeric_limits<double>::quiet_NaN(), M.ok = false;
+        inf.message = buf;
+        inf.grad_max = gmax, inf.grad_floor = floor;
+        inf.seconds_total = since(t_start);
+        return out;
+    }
 
     // Affine predictions: d2E/dt2 along the affine path x(t) = F(t) x_ref with no relaxation: at the affinely deformed
     // reference q_a, E_tt + 2 v.E_xt + v.H v with v = dF F^{-1} x the affine velocity (one more assembly). This is
@@ -98,6 +119,7 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
     core.seconds_assembly += inf.seconds_assembly;
     core.seconds_affine = inf.seconds_affine;
     inf = core;
+    inf.grad_max = gmax, inf.grad_floor = floor;
     inf.seconds_total = since(t_start);
     return relaxed;
 }
@@ -292,6 +314,9 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
             for (size_t m = 0; m < out.size(); ++m) out[m].error = std::max(out[m].error, std::abs(out[m].value - kept[m].value));
         }
     }
+    // A failed modulus has no value: NaN, so that a caller who forgets `ok` does not carry a plausible number on.
+    for (auto& M : out)
+        if (!M.ok) M.value = M.error = std::numeric_limits<double>::quiet_NaN();
     inf.seconds_total = since(t_start);
     return out;
 }

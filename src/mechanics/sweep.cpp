@@ -34,13 +34,16 @@ struct Response {
 };
 
 // Stress, differential modulus and tangent at an equilibrium q of F(t).
-Response respond(const NetworkEnergy& e, const Eigen::VectorXd& q, double t, StrainKind kind) {
+// tol: the solver's; a state it accepted is an equilibrium for linear_moduli too.
+Response respond(const NetworkEnergy& e, const Eigen::VectorXd& q, double t, StrainKind kind, double tol) {
     Response r;
     const Eigen::Matrix2d F = deformation(kind, t);
     const double A0 = e.model().box.reference_area();
     StrainMode mode{"path", strain_direction(kind), 1.0 / A0};
     ModuliInfo info;
-    const auto mods = linear_moduli(e, q, F, {mode}, {}, &info);
+    ModuliOptions mo;
+    mo.equilibrium_tol = std::max(mo.equilibrium_tol, tol);
+    const auto mods = linear_moduli(e, q, F, {mode}, mo, &info);
     const Modulus& M = mods.front();
     r.ok = M.ok;
     r.message = info.message;
@@ -68,7 +71,7 @@ SweepOutcome run_sweep(const NetworkEnergy& e, const SweepParams& p, Solver& sol
     Response resp;
     if (resume) {
         s = *resume;
-        resp = respond(e, s.q, s.t, p.kind);
+        resp = respond(e, s.q, s.t, p.kind, solver.options().tol);
         if (!resp.ok) {
             out.message = "linear response failed at the resumed state: " + resp.message;
             return out;
@@ -81,7 +84,7 @@ SweepOutcome run_sweep(const NetworkEnergy& e, const SweepParams& p, Solver& sol
             return out;
         }
         s.q = eq.q, s.t = 0, s.step = 0, s.next_step = p.step;
-        resp = respond(e, s.q, 0, p.kind);
+        resp = respond(e, s.q, 0, p.kind, solver.options().tol);
         if (!resp.ok) {
             out.message = "linear response failed at t = 0: " + resp.message;
             return out;
@@ -118,7 +121,7 @@ SweepOutcome run_sweep(const NetworkEnergy& e, const SweepParams& p, Solver& sol
             // and the solver found the next stable state, which is what a quasistatic experiment does too.
             const bool slow = eq.result.iterations > p.max_iterations && 0.5 * h >= p.min_step;
             if (eq.converged() && !slow) {
-                Response r = respond(e, eq.q, t_new, p.kind);
+                Response r = respond(e, eq.q, t_new, p.kind, solver.options().tol);
                 if (r.ok) {
                     resp = std::move(r);
                     s.t = t_new;

@@ -26,6 +26,17 @@ double mean_diag(const Eigen::SparseMatrix<double>& H) {
     return n > 0 ? s / n : 1.0;
 }
 
+constexpr double kArmijo = 1e-4;
+constexpr double kDescent = 1e-12;    // g.d < -kDescent |g| |d|
+constexpr double kMuFloor = 1e-13;    // relative to mean diag: round-off scale of a null pivot
+constexpr double kMuStart = 1e-8;     // relative to mean diag: first Levenberg-Marquardt shift
+constexpr double kLambda0 = 1e-8;     // rung 2 start, relative to mean diag
+constexpr int kLambdaSteps = 11;
+constexpr double kExactGrow = 4;      // rung 0 escalation factor
+constexpr double kExactCap = 0.2;     // rung 0 escalation stops above this x mean diag
+constexpr int kMaxHalvings = 60;
+}  // namespace
+
 // max_i sum_j |H_ij| ulp(max(|q_j|, 1)): the gradient error of rounding every coordinate to its floating-point spacing.
 double roundoff_floor(const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& q) {
     const int n = static_cast<int>(q.size());
@@ -46,16 +57,6 @@ double roundoff_floor(const Eigen::SparseMatrix<double>& H, const Eigen::VectorX
     return n > 0 ? r.maxCoeff() : 0.0;
 }
 
-constexpr double kArmijo = 1e-4;
-constexpr double kDescent = 1e-12;    // g.d < -kDescent |g| |d|
-constexpr double kMuFloor = 1e-13;    // relative to mean diag: round-off scale of a null pivot
-constexpr double kMuStart = 1e-8;     // relative to mean diag: first Levenberg-Marquardt shift
-constexpr double kLambda0 = 1e-8;     // rung 2 start, relative to mean diag
-constexpr int kLambdaSteps = 11;
-constexpr double kExactGrow = 4;      // rung 0 escalation factor
-constexpr double kExactCap = 0.2;     // rung 0 escalation stops above this x mean diag
-constexpr int kMaxHalvings = 60;
-}  // namespace
 
 CholmodLLT& NewtonSolver::factorization_for(const Eigen::SparseMatrix<double>& H, double* seconds) {
     // Symbolic analysis once per pattern (kept across calls while the pattern is the same).

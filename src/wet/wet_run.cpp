@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 
+#include "fibernet/util/error.hpp"
 #include "fibernet/wet/wet_moduli.hpp"
 
 namespace fibernet {
@@ -57,6 +58,22 @@ double relaxed_shear_modulus(const NetworkEnergy& dry, const Eigen::Matrix2d& F,
 
 WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, const WetRunOptions& opt,
                const WetState* dry_start) {
+    // What the CLI refuses up front, refused here too: a library caller got a crash (a trimmed model) or a
+    // meaningless "converged" (a free box without a periodic box).
+    if (m.chains.size() != net.fibers.size() || m.crossing_node.size() != net.crossings.size())
+        throw InputError("run_wet: the model (" + std::to_string(m.chains.size()) + " fibers, " +
+                         std::to_string(m.crossing_node.size()) + " crossings) was not discretized from this network (" +
+                         std::to_string(net.fibers.size()) + " fibers, " + std::to_string(net.crossings.size()) + ")");
+    for (size_t f = 0; f < m.chains.size(); ++f) {
+        const FiberChain& ch = m.chains[f];
+        const double len = net.fibers[f].length * m.fiber_length;
+        if (ch.s.size() < 2 || ch.s.front() > 1e-9 * len || ch.s.back() < len * (1 - 1e-9))
+            throw InputError("run_wet: fiber " + std::to_string(f) +
+                             " is not whole in the model (end arms trimmed or fiber dropped, e.g. by trim_ends): "
+                             "capillary bridges sit on the end arms");
+    }
+    if (opt.free_box.enabled && !m.box.periodic)
+        throw InputError("run_wet: the free box needs a periodic network (an open network has no box stress)");
     WetRun run;
     NetworkEnergy dry(m);
     const Eigen::Matrix2d B = F * m.box.B0();
@@ -105,7 +122,7 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     run.wet.pores = pores(m, x, B);
     run.bundles = bundles(m, x, B, run.active.bridges, opt.bundle_angle_deg);
     run.seconds_pores += now() - t0;
-    if (opt.moduli && run.wet.converged) {
+    if (opt.moduli && run.wet.converged && run.active.stable) {  // the moduli of a consistent bridge set only
         t0 = now();
         shear_moduli(run.wet, dry, F, run.active.bridges, opt.params, *solver, opt.modulus_strain);
         run.seconds_moduli += now() - t0;

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "fd.hpp"
 #include "fibernet/energy/network_energy.hpp"
@@ -272,4 +273,25 @@ TEST_CASE("network energy: per-element PSD projection gives a positive semidefin
     Hd = Eigen::MatrixXd(Eigen::MatrixXd(H).selfadjointView<Eigen::Upper>());
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> proj(Hd);
     CHECK(proj.eigenvalues().minCoeff() > -1e-9 * proj.eigenvalues().maxCoeff());
+}
+
+// The energy keeps references: a temporary Model (or NetworkEnergy for the objectives) would dangle, and the
+// library used to accept it silently (a segfault later). Compile-time checks: they fail to compile if the deleted
+// overloads go.
+static_assert(!std::is_constructible<NetworkEnergy, Model&&>::value, "NetworkEnergy from a temporary Model");
+static_assert(std::is_constructible<NetworkEnergy, const Model&>::value, "NetworkEnergy from a Model");
+static_assert(!std::is_constructible<StrainedEnergy, NetworkEnergy&&, const Eigen::Matrix2d&>::value,
+              "StrainedEnergy from a temporary NetworkEnergy");
+
+TEST_CASE("network energy: coordinates of the wrong size are refused", "[energy]") {
+    // Eigen checks no sizes with NDEBUG: q of another model read past its end (NaN or a crash).
+    const Model m = small_model(true, Scheme::Seed);
+    const NetworkEnergy e(m);
+    const Eigen::VectorXd q = e.dofs(m.x);
+    const Eigen::VectorXd shorter = q.head(q.size() - 2);
+    EnergyEval ev;
+    CHECK_THROWS_WITH(e.evaluate(shorter, Eigen::Matrix2d::Identity(), Eigen::Matrix2d::Zero(), kGradient, ev),
+                      Catch::Contains("coordinates"));
+    CHECK_THROWS(e.positions(shorter, Eigen::Matrix2d::Identity()));
+    CHECK_NOTHROW(e.evaluate(q, Eigen::Matrix2d::Identity(), Eigen::Matrix2d::Zero(), kGradient, ev));
 }

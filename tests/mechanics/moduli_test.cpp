@@ -290,3 +290,34 @@ TEST_CASE("an empty network and one without crosslinks have G = 0, no crash", "[
         CHECK(std::abs(lin.G) <= 1e-8 * lin.G_aff);
     }
 }
+
+TEST_CASE("linear moduli refuse a state that is not an equilibrium", "[moduli][edge]") {
+    // Before, a state off its equilibrium (Newton stopped a few iterations early) gave G several percent off with
+    // ok = true and a bound of 1e-10: the formula E_tt - E_xt.H^+ E_xt holds at an equilibrium only.
+    const Model m = make_model(5, 8, 1, 10, 1);
+    const NetworkEnergy e(m);
+    const Eigen::Matrix2d F = deformation(StrainKind::Shear, 0.05);
+    NewtonSolver newton(options());
+    const Equilibrium eq = relax(e, F, newton);
+    REQUIRE(eq.converged());
+    ModuliInfo info;
+    const auto good = linear_moduli(e, eq.q, F, {shear_mode(F, 2500)}, {}, &info);
+    CHECK(good[0].ok);
+    CHECK(std::isfinite(good[0].value));
+    CHECK(info.grad_max <= std::max(1e-6, info.grad_floor));
+    // Near it (every coordinate off by up to 1e-8 seed units: max|g| ~ 1; H as positive definite as there).
+    Eigen::VectorXd off = eq.q;
+    for (int i = 0; i < off.size(); ++i) off[i] += 1e-8 * std::sin(1.7 * i);
+    const auto bad = linear_moduli(e, off, F, {shear_mode(F, 2500)}, {}, &info);
+    INFO(info.message);
+    CHECK(!bad[0].ok);
+    CHECK(std::isnan(bad[0].value));
+    CHECK(info.grad_max > 1e-6);
+    CHECK(info.message.find("not an equilibrium") != std::string::npos);
+    // The caller may accept it knowingly (equilibrium_tol): then the number comes back.
+    ModuliOptions loose;
+    loose.equilibrium_tol = 2 * info.grad_max;
+    const auto taken = linear_moduli(e, off, F, {shear_mode(F, 2500)}, loose);
+    CHECK(taken[0].ok);
+    CHECK(taken[0].value != Approx(good[0].value).epsilon(1e-9));  // and it is not the equilibrium's
+}

@@ -215,3 +215,38 @@ TEST_CASE("wet relaxation: a solve that uses its whole iteration budget without 
     CHECK(r.rounds < opt.max_rounds);
     CHECK(r.message.find("iteration limit") != std::string::npos);
 }
+
+TEST_CASE("run_wet refuses what the CLI refuses, and computes no modulus for an unsettled bridge set", "[wet][relax]") {
+    const Network net = mikado(3.0, 10, 0.5, 2);
+    WetRunOptions opt;
+    opt.params.beta = 0.01;
+    opt.solver_options.tol = 1e-9;
+    // A model whose end arms are trimmed: bridges sit on them (before: a segfault in make_bridge).
+    DiscretizationParams trimmed;
+    trimmed.trim_ends = true;
+    const Model mt = discretize(net, trimmed);
+    CHECK_THROWS_WITH(run_wet(net, mt, Eigen::Matrix2d::Identity(), opt), Catch::Contains("not whole"));
+    // A model of another network (before: thousands of bogus bridges).
+    const Model other = model_of(mikado(3.0, 10, 0.5, 3), 10);
+    CHECK_THROWS_WITH(run_wet(net, other, Eigen::Matrix2d::Identity(), opt), Catch::Contains("not discretized from"));
+    // The free box of an open network (before: "converged after 0 iterations", a meaningless s = 1).
+    MikadoParams mp;
+    mp.L = 3, mp.q = 10, mp.pl = 0.5, mp.seed = 2, mp.periodic = false;
+    const Network open = generate_mikado(mp);
+    const Model mo = model_of(open, 10);
+    WetRunOptions fb = opt;
+    fb.free_box.enabled = true;
+    CHECK_THROWS_WITH(run_wet(open, mo, Eigen::Matrix2d::Identity(), fb), Catch::Contains("periodic"));
+    // Stopped after 2 rounds: the last solve converged but the set is not stable, so no modulus (before: a G of an
+    // inconsistent set, 0.00983 against the stable 0.01178 on problems/wet.toml).
+    const Model m = model_of(net, 10);
+    WetRunOptions two = opt;
+    two.active_set.max_rounds = 2;
+    two.active_set.round_iterations = 0;
+    const WetRun r = run_wet(net, m, Eigen::Matrix2d::Identity(), two);
+    INFO(r.active.message);
+    REQUIRE(!r.active.stable);
+    CHECK(std::isfinite(r.dry.shear_modulus));
+    CHECK(std::isnan(r.wet.shear_modulus));
+    CHECK(std::isnan(r.wet.shear_modulus_fd));
+}

@@ -18,7 +18,7 @@ Eigen::Matrix2d strain_direction(StrainKind k);      // dF/dt
 Eigen::Matrix2d deformation(StrainKind k, double t);  // F(t) = I + t dF
 
 struct Box {
-    double L = 1.0;          // side in model units
+    double L = 1.0;          // side in model (seed) units: 10x Network::L, which is in fiber lengths
     bool periodic = true;
     Eigen::Matrix2d F = Eigen::Matrix2d::Identity();
 

@@ -41,7 +41,9 @@ struct EnergyEval {
 
 class NetworkEnergy {
 public:
+    // Keeps a reference to `model`, which must outlive the energy (a temporary would dangle: refused).
     explicit NetworkEnergy(const Model& model, EnergyParams params = {});
+    NetworkEnergy(const Model&& model, EnergyParams params = {}) = delete;
 
     const Model& model() const { return model_; }
     int num_dofs() const { return ndof_; }
@@ -84,7 +86,8 @@ private:
 // The energy at a fixed deformation F, as a solver sees it.
 class StrainedEnergy : public Objective {
 public:
-    StrainedEnergy(const NetworkEnergy& e, const Eigen::Matrix2d& F) : e_(e), F_(F) {}
+    StrainedEnergy(const NetworkEnergy& e, const Eigen::Matrix2d& F) : e_(e), F_(F) {}  // keeps a reference to e
+    StrainedEnergy(const NetworkEnergy&& e, const Eigen::Matrix2d& F) = delete;
     int size() const override { return e_.num_dofs(); }
     double value(const Eigen::VectorXd& q) override;
     double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override;

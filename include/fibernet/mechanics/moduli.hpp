@@ -5,7 +5,7 @@
 //   d2E/dt2 (relaxed) = E_tt - E_xt^T H^+ E_xt,    H = E_xx, E_xt = d2E/dx dt, E_tt = d2E/dt2 at fixed x,
 // and a modulus is scale * that. E_xt lies in range(H) at an equilibrium (differentiate g(q*(t), t) = 0), so
 // H's null space (translations, floppy clusters) does not contribute. H^+ E_xt is computed with ONE
-// factorization of H + delta I (delta = 1e-12 mean diag H, grown on failure), used as the preconditioner of
+// factorization of H + delta I (delta = 1e-12 median |diag H|, grown on failure), used as the preconditioner of
 // conjugate gradients on H u = E_xt: the preconditioned spectrum lambda / (lambda + delta) is 1 except for the few
 // modes with lambda ~ delta, so CG converges in a handful of steps, each one solve and no new factorization;
 // from u_0 = 0 it never enters the null space (the residual stays in range(H)). The last increments of
@@ -37,7 +37,7 @@ StrainMode path_mode(StrainKind k, double area);
 
 struct Modulus {
     std::string name;
-    double value = 0;       // scale * (E_tt - E_xt^T H^+ E_xt)
+    double value = 0;       // scale * (E_tt - E_xt^T H^+ E_xt); NaN when !ok
     double affine = 0;      // scale * E_tt of the affinely deformed reference (the affine prediction)
     double E_tt = 0, correction = 0;  // unscaled affine (comoving) part and non-affine correction at the equilibrium
     double error = 0;       // bound on |value error| from the refinement (scaled)
@@ -51,10 +51,14 @@ struct ModuliOptions {
     double delta_rel = 1e-12;   // initial shift relative to median |diag H| (x100 while the factorization fails)
     int max_refinements = 200;  // conjugate-gradient steps
     double refine_tol = 1e-13;  // stop when a CG increment of E_xt.u is below this fraction of max(E_tt, b.M b)
+    // linear_moduli: q must be an equilibrium, max|g| <= max(equilibrium_tol, the round-off floor of the coordinates
+    // (roundoff_floor, newton.hpp)); otherwise every modulus is refused (ok = false, the message says why).
+    double equilibrium_tol = 1e-6;
 };
 
 struct ModuliInfo {
     double delta = 0;          // shift of the factorization used
+    double grad_max = 0, grad_floor = 0;  // linear_moduli: max|g| at q and its round-off floor
     int factorizations = 0;
     double seconds_assembly = 0, seconds_factorization = 0, seconds_solve = 0, seconds_affine = 0, seconds_total = 0;
     double seconds_one_factorization = 0;   // the successful factorization alone, for the modulus/factorization ratio

@@ -2,6 +2,7 @@
 // Mikado generator (DESIGN.md §2): N = round(q L^2) fibers of unit length, centres uniform in the L x L box,
 // orientations uniform in [0, pi); every crossing is a crosslink with probability pl.
 #include <cstdint>
+#include <string>
 
 #include "fibernet/network/network.hpp"
 

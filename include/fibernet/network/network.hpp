@@ -3,6 +3,7 @@
 // Crossings are the points where two fibers (or a fiber and a periodic image of another) intersect;
 // each is a crosslink (a pin, seed §3.2) or a free crossing (a site for a capillary bridge).
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -29,7 +30,7 @@ struct Crossing {
 };
 
 struct Network {
-    double L = 1;          // box side in fiber lengths
+    double L = 1;          // box side in fiber lengths (the Model's Box::L is in seed units, 10x larger)
     bool periodic = true;
     std::vector<Fiber> fibers;
     std::vector<Crossing> crossings;  // sorted by (f1, f2)

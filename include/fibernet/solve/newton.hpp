@@ -21,6 +21,7 @@
 // stretch.hpp). Near convergence the energy decrease falls below round-off; a full step is then accepted when
 // the energy did not rise beyond round-off and max|g| fell.
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "fibernet/solve/cholmod_ldl.hpp"
@@ -28,6 +29,11 @@
 #include "fibernet/solve/solver.hpp"
 
 namespace fibernet {
+
+// The round-off floor of max|g| at q (H: the Hessian there, upper triangle): max_i sum_j |H_ij| ulp(max(|q_j|, 1)),
+// the gradient error of rounding every coordinate to its floating-point spacing. Newton accepts a state at this
+// floor when it stalls above tol (docs/moduli.md, "Round-off floor"); linear_moduli accepts an equilibrium there.
+double roundoff_floor(const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& q);
 
 class NewtonSolver : public Solver {
 public:

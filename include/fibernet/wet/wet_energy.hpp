@@ -29,7 +29,9 @@ struct WetSplit {
 
 class WetEnergy : public Objective {
 public:
+    // Keeps a reference to `dry` (and through it to its Model), which must outlive this energy.
     WetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, std::vector<Bridge> bridges, WetParams params);
+    WetEnergy(const NetworkEnergy&& dry, const Eigen::Matrix2d& F, std::vector<Bridge> bridges, WetParams params) = delete;
 
     int size() const override { return dry_.num_dofs(); }
     double value(const Eigen::VectorXd& q) override;
