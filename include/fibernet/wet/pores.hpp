@@ -4,9 +4,12 @@
 // torus: edges carry their unwrapped vectors and each face is traced as a closed polygon of them.
 //
 // Faces are traced with the face on the left (half-edge `next` = the outgoing edge just clockwise of the reverse
-// edge), so a pore's boundary runs counter-clockwise and its shoelace area is positive. A traced cycle that does not
-// close (it winds around the torus) or has no positive area (the outside of an open network, or the boundary of a
-// region that is not a disk) is no pore: the box area not covered by pores is reported as `remainder`.
+// edge), so a pore's boundary runs counter-clockwise and its shoelace area is positive. Each crossing is one point
+// on both segments, and pieces shorter than 1e-9 L are contracted (fibers zipped on top of each other). A traced
+// cycle that winds around the torus (`open_cycles`), or has no positive area (the outer boundary of a component: the
+// outside of an open network, or an island), bounds no pore; a closed face with an island inside (the smallest such
+// face of another component around a point of it) is not a disk and is no pore either. The box area not covered by
+// pores is reported as `remainder`.
 #include <Eigen/Core>
 #include <vector>
 
@@ -21,10 +24,12 @@ struct Pore {
 };
 
 struct PoreStats {
-    std::vector<Pore> pores;   // every closed face of positive area
+    std::vector<Pore> pores;   // every closed face of positive area that is a disk (no island inside)
     double box_area = 0;
     double remainder = 0;      // box area - sum of pore areas (outer / non-disk faces)
-    int vertices = 0, edges = 0, open_cycles = 0;
+    int vertices = 0, edges = 0;
+    int open_cycles = 0;  // face boundaries that wind around the torus (whole box vectors summing to non-zero)
+    int islands = 0;      // components inside a closed face (which then goes to the remainder)
 };
 
 // Pores at node positions x in the box with matrix B (model units).
