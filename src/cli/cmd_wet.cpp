@@ -3,16 +3,26 @@
 // With --free-box (or [wet] free_box = true) each beta's wet state is then taken to its zero-stress box (drying
 // shrinkage; docs/wet.md, "Free box"), one progress line per outer iteration on stderr.
 // Exit 1 when a relaxation did not reach a stable equilibrium or the free box did not converge (results still
-// reported, marked).
+// reported, marked). With -o, the directory's previous results are invalidated at the start, and the tables and
+// summary.json (complete: false) are rewritten after every beta; SIGINT/SIGTERM end the run at once with the finished
+// betas kept and reported (exit 130).
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "common.hpp"
 #include "fibernet/energy/capillary.hpp"
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/util/error.hpp"
+#include "fibernet/util/hash.hpp"
 #include "fibernet/wet/wet_run.hpp"
 #include "fibernet/wet/wet_svg.hpp"
 
@@ -21,6 +31,132 @@ namespace fibernet::cli {
 nlohmann::json solve_json(const SolveResult& r, double tol);  // cmd_modulus.cpp
 
 namespace {
+// Interrupts (SIGINT, SIGTERM). A beta's relaxation cannot be stopped midway (run_wet has no stop hook, and one beta
+// can take minutes), so the handler ends the process at once with what is finished: the report of the finished betas
+// (prepared after each one) on stdout, a line on stderr, exit 130; their files are on disk already. The handler may run
+// on any thread (OpenMP, OpenBLAS, FIBERNET_THREADS workers), so the main thread holds it off with g_state while it
+// writes files or changes the prepared texts (kWriting): a signal then is only noted (g_pending) and the writer exits
+// when done. Whoever moves kRunning -> kExiting exits; the other waits for it.
+enum : int { kRunning = 0, kWriting = 1, kExiting = 2 };
+std::atomic<int> g_state{kRunning};
+std::atomic<bool> g_pending{false};
+std::string g_report, g_message;  // changed only in kWriting, read only in kExiting
+
+void write_all(int fd, const std::string& s) {  // write(2) only: async-signal-safe
+    const char* p = s.data();
+    size_t n = s.size();
+    while (n > 0) {
+        const ssize_t w = ::write(fd, p, n);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) return;
+        p += w, n -= static_cast<size_t>(w);
+    }
+}
+
+[[noreturn]] void exit_interrupted() {
+    write_all(STDOUT_FILENO, g_report);
+    write_all(STDERR_FILENO, g_message);
+    _exit(130);
+}
+
+extern "C" void on_wet_signal(int) {
+    const int saved = errno;
+    for (;;) {
+        int expected = kRunning;
+        if (g_state.compare_exchange_strong(expected, kExiting)) exit_interrupted();
+        if (expected == kExiting) break;  // a second signal, or the writer is exiting already
+        g_pending = true;                  // kWriting: the writer exits when done
+        if (g_state.load() == kWriting) break;
+        // The writer finished before it could see g_pending: exit here, or let it (whoever wins the exchange).
+    }
+    errno = saved;
+}
+
+// hold() holds the handler off (kWriting) while the main thread writes files or the prepared texts; release() lets it
+// act again, and ends the run at once if an interrupt came meanwhile (the files are complete by then).
+void hold() {
+    int expected = kRunning;
+    if (!g_state.compare_exchange_strong(expected, kWriting))
+        for (;;) pause();  // the handler is exiting the process
+}
+
+void release() {
+    g_state = kRunning;
+    if (g_pending) {
+        int expected = kRunning;
+        if (g_state.compare_exchange_strong(expected, kExiting)) exit_interrupted();
+        for (;;) pause();
+    }
+}
+
+// Installs the handler for the loop over betas and puts the previous dispositions back when the command ends (also by
+// an exception). A SIGINT ignored from the start stays ignored: a shell script's background job gets it so, and
+// Ctrl-C meant for the script must not end it (SIGTERM still does).
+struct InterruptScope {
+    struct sigaction old_int {}, old_term {};
+    InterruptScope() {
+        struct sigaction sa {};
+        sa.sa_handler = on_wet_signal;
+        sigemptyset(&sa.sa_mask);
+        sa.sa_flags = SA_RESTART;
+        sigaction(SIGINT, nullptr, &old_int);
+        if (old_int.sa_handler != SIG_IGN) sigaction(SIGINT, &sa, nullptr);
+        sigaction(SIGTERM, &sa, &old_term);
+    }
+    ~InterruptScope() {
+        sigaction(SIGINT, &old_int, nullptr);
+        sigaction(SIGTERM, &old_term, nullptr);
+    }
+};
+
+// --betas: comma-separated lists (one or more of them). CLI11's own split drops empty entries ("0,,0.1" ran two
+// betas), so the lists are split here and every entry must be a number.
+std::vector<double> parse_betas(const std::vector<std::string>& lists) {
+    std::vector<double> betas;
+    for (const std::string& list : lists) {
+        const std::string where = "command line: --betas '" + list + "'";
+        size_t start = 0;
+        for (int entry = 1;; ++entry) {
+            const size_t comma = list.find(',', start);
+            std::string t = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+            const size_t a = t.find_first_not_of(" \t"), b = t.find_last_not_of(" \t");
+            t = a == std::string::npos ? "" : t.substr(a, b - a + 1);
+            if (t.empty()) throw InputError(where + ": entry " + std::to_string(entry) + " is empty");
+            char* end = nullptr;
+            const double v = std::strtod(t.c_str(), &end);
+            if (*end) throw InputError(where + ": entry " + std::to_string(entry) + ", '" + t + "', is not a number");
+            check_value(v >= 0, v, where, "beta", "must be >= 0");
+            betas.push_back(v);
+            if (comma == std::string::npos) break;
+            start = comma + 1;
+        }
+    }
+    return betas;
+}
+
+// The bytes of a file the run depends on (a law table), for the summary; throws InputError if unreadable.
+std::string file_text(const std::string& path, const std::string& what) {
+    std::ifstream is(path, std::ios::binary);
+    std::ostringstream os;
+    if (!is || !(os << is.rdbuf())) throw InputError(what + " '" + path + "' cannot be read");
+    return os.str();
+}
+
+std::uint64_t fnv1a_text(const std::string& text) {
+    std::uint64_t h = kFnvOffset;
+    for (unsigned char c : text) h = fnv1a(h, c);
+    return h;
+}
+
+// This process's arguments (Linux /proc), so a summary says how it was made; null where /proc is missing.
+nlohmann::json command_line() {
+    std::ifstream is("/proc/self/cmdline", std::ios::binary);
+    if (!is) return nullptr;
+    nlohmann::json args = nlohmann::json::array();
+    for (std::string a; std::getline(is, a, '\0');) args.push_back(a);
+    return args.empty() ? nlohmann::json() : args;
+}
+
 nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
 nlohmann::json pore_json(const PoreStats& p) {
@@ -113,7 +249,7 @@ void register_wet(CLI::App& app) {
     cmd->get_option("--pl")->description("crosslink probability in [0, 1] (default 0.5 here, as the thesis's wet networks)");
     struct WetFlags {
         double beta = 0, fraction = 0;
-        std::vector<double> betas;
+        std::vector<std::string> betas;
         std::string law, crossings, out;
         std::uint64_t seed = 0;
         bool no_moduli = false, verbose = false, quiet = false, free_box = false;
@@ -124,11 +260,12 @@ void register_wet(CLI::App& app) {
     };
     auto w = std::make_shared<WetFlags>();
     auto* o_beta = cmd->add_option("--beta", w->beta, "adhesion per unit bundle length, bending units (default 1)");
-    cmd->add_option("--betas", w->betas, "a beta sweep, e.g. --betas 0,0.1,0.3,1 (overrides --beta)")->delimiter(',');
+    // Split by parse_betas, not by CLI11's delimiter, which drops empty entries.
+    cmd->add_option("--betas", w->betas, "a beta sweep, comma-separated, e.g. --betas 0,0.1,0.3,1 (overrides --beta)");
     auto* o_law = cmd->add_option("--law", w->law, "tabulated capillary law file: lines 'alpha_deg value'");
     auto* o_cr = cmd->add_option("--crossings", w->crossings, "wet crossings: all | free | fraction (default all)");
     auto* o_fr = cmd->add_option("--fraction", w->fraction, "wet fraction of crossings, in [0, 1]");
-    auto* o_ws = cmd->add_option("--wet-seed", w->seed, "seed of the wet fraction draw")->check(seed_check());
+    auto* o_ws = cmd->add_option("--wet-seed", w->seed, "seed of the wet fraction draw (with --crossings fraction)")->check(seed_check());
     auto* o_bp = cmd->add_option("--bundle-partners", w->bundle_partners,
                                  "excluded volume: a segment adheres along at most N other fibers (0: no cap, the "
                                  "default; 2: flat ribbon; 6: close-packed; docs/wet.md)");
@@ -163,11 +300,16 @@ void register_wet(CLI::App& app) {
         if (o_bp->count()) s.wet.bundle_partners = w->bundle_partners;
         s.source = flags->scene_file.empty() ? "command line" : flags->scene_file + " + command line";
         s.check();
-        std::vector<double> betas = w->betas.empty() ? std::vector<double>{s.wet.beta} : w->betas;
-        for (double b : betas) check_value(b >= 0, b, "--betas", "beta", "must be >= 0");
+        const std::vector<double> betas = w->betas.empty() ? std::vector<double>{s.wet.beta} : parse_betas(w->betas);
 
         WetRunOptions opt;
-        if (!s.wet.law.empty()) opt.params.law = CapillaryLaw::read(s.wet.law);
+        std::string law_text;  // recorded in the summary: the file may change or go
+        if (!s.wet.law.empty()) {
+            opt.params.law = CapillaryLaw::read(s.wet.law);
+            law_text = file_text(s.wet.law, "capillary law file");
+        }
+        std::string network_text;
+        if (!s.network_file.empty()) network_text = file_text(s.network_file, "network file");
         opt.rule.which = parse_wet_which(s.wet.crossings);
         opt.rule.fraction = s.wet.fraction, opt.rule.seed = s.wet.seed;
         opt.solver = s.solver.name;
@@ -225,27 +367,86 @@ void register_wet(CLI::App& app) {
         std::vector<SvgPanel> panels;
         std::vector<std::string> hist_names;
         std::vector<std::vector<double>> hist_values;
+        // Everything the results depend on (docs/formats.md, "Wet scenes": summary.json), so that a run can be
+        // repeated and a rerun told apart from it (bench/run_wet_pores.sh compares them before it skips a seed).
+        nlohmann::json parameters = scene_parameters(s);  // which network the summary describes
+        if (!s.network_file.empty()) parameters["network_file_fnv1a"] = fnv1a_text(network_text);
+        const bool fraction = s.wet.crossings == "fraction";
+        const nlohmann::json wet_settings = {
+            {"betas", betas},
+            {"law", s.wet.law.empty() ? "cos2" : s.wet.law},
+            {"law_table", s.wet.law.empty() ? nlohmann::json() : nlohmann::json(law_text)},
+            {"law_fnv1a", s.wet.law.empty() ? nlohmann::json() : nlohmann::json(fnv1a_text(law_text))},
+            {"crossings", s.wet.crossings},
+            {"fraction", s.wet.fraction},
+            {"seed", fraction ? nlohmann::json(s.wet.seed) : nlohmann::json()},  // no draw otherwise
+            {"max_rounds", s.wet.max_rounds},
+            {"round_iterations", s.wet.round_iterations},
+            {"newton_ldl", s.wet.newton_ldl},
+            {"local_fraction", s.wet.local_fraction},
+            {"local_threshold", s.wet.local_threshold},
+            {"local_hops", s.wet.local_hops},
+            {"bundle_partners", s.wet.bundle_partners},
+            {"free_box", s.wet.free_box},
+            {"free_box_shape", s.wet.free_box ? nlohmann::json(s.wet.free_box_shape) : nlohmann::json()},
+            {"free_box_tol", s.wet.free_box ? nlohmann::json(s.wet.free_box_tol) : nlohmann::json()},
+            {"moduli", opt.moduli},
+            {"modulus_strain", opt.moduli ? nlohmann::json(opt.modulus_strain) : nlohmann::json()}};
+        const nlohmann::json command = command_line();
         auto summary = [&](bool complete) {
             return nlohmann::json{{"scene", s.source},
-                                {"parameters", scene_parameters(s)},  // which network the summary describes
+                                {"command", command},
+                                {"parameters", parameters},
+                                {"prune", prune_rules(s)},
                                 {"network", to_json(statistics(net))},
                                 {"model", to_json(summarize(m))},
-                                {"wet",
-                                 {{"law", s.wet.law.empty() ? "cos2" : s.wet.law},
-                                  {"crossings", s.wet.crossings},
-                                  {"fraction", s.wet.fraction},
-                                  {"free_box", s.wet.free_box},
-                                  {"bundle_partners", s.wet.bundle_partners}}},
+                                {"wet", wet_settings},
                                 {"strain", to_string(s.strain)},
                                 {"gamma", s.gamma},
+                                {"solver", {{"name", s.solver.name}, {"tol", s.solver.tol}, {"max_iter", s.solver.max_iter}}},
                                 {"runs", runs},
                                 {"complete", complete},
                                 {"seconds", seconds_since(t_all)}};
         };
+        // Before beta k: the files of the betas before it (at k = 0, none: the directory's previous results are
+        // replaced at once, so an interrupted or failed rerun leaves no stale "complete" summary, rows or pictures),
+        // and what an interrupt during beta k prints.
+        const std::string dir = w->out.empty() ? "" : w->out + "/";
+        auto checkpoint = [&](size_t k) {
+            if (!dir.empty()) {
+                if (k == 0)  // drawn at the end only; until then no pictures of another run
+                    for (const char* f : {"network.svg", "pores.svg"}) {
+                        std::error_code ec;
+                        std::filesystem::remove(dir + f, ec);
+                        if (ec) throw InputError("--out-dir '" + w->out + "': cannot remove the previous " + f + " (" +
+                                                 ec.message() + ")");
+                    }
+                emit_json(summary(false), dir + "summary.json");
+                write_file_atomic(dir + "sweep.csv", sweep.str());
+                write_file_atomic(dir + "pores.csv", pore_csv.str());
+            }
+            nlohmann::json r = summary(false);
+            r["interrupted"] = true;
+            g_report = r.dump(2) + "\n";
+            std::ostringstream m;
+            m << "wet: interrupted during beta = " << betas[k] << " (" << k + 1 << " of " << betas.size() << "); "
+              << (k == 0 ? std::string("no beta finished")
+                         : std::to_string(k) + " finished beta(s) kept" +
+                               (dir.empty() ? std::string("") : " in " + w->out + " (summary.json: complete false, "
+                                                                                   "sweep.csv, pores.csv)") +
+                               " and reported on stdout")
+              << "\n";
+            g_message = m.str();
+        };
+        hold();  // before the handler exists: nothing to report until checkpoint(0) has run
+        InterruptScope interrupts;
+        checkpoint(0);
+        release();
         for (size_t k = 0; k < betas.size(); ++k) {
             opt.params.beta = betas[k];
             if (!w->quiet) std::fprintf(stderr, "wet: beta = %g (%zu of %zu)\n", betas[k], k + 1, betas.size());
             const WetRun r = run_wet(net, m, F, opt, k == 0 ? nullptr : &dry_state);
+            hold();  // beta k is finished: from here until its files are written, an interrupt waits
             if (!w->quiet)
                 std::fprintf(stderr, "wet: beta = %g: %s, %zu bridges, %d solver iterations, %.1f s\n", betas[k],
                              r.active.message.c_str(), r.active.bridges.size(), r.active.solver_iterations,
@@ -345,22 +546,17 @@ void register_wet(CLI::App& app) {
                    {"wet_local", r.active.seconds_local}, {"local_setup", r.active.seconds_local_setup},
                    {"bridge_update", r.active.seconds_update}, {"gradient", r.active.seconds_gradient}}}});
             // Finished betas survive an interrupt: the tables and summary.json (complete: false) are rewritten
-            // (atomically) after each one; the pictures and stdout come at the end.
-            if (!w->out.empty() && k + 1 < betas.size()) {
-                const std::string d = w->out + "/";
-                write_file_atomic(d + "sweep.csv", sweep.str());
-                write_file_atomic(d + "pores.csv", pore_csv.str());
-                emit_json(summary(false), d + "summary.json");
-            }
+            // (atomically) after each one; the pictures and stdout come at the end. After the last beta the handler
+            // stays held off: the results are complete.
+            if (k + 1 < betas.size()) checkpoint(k + 1), release();
         }
         const nlohmann::json j = summary(true);
-        if (!w->out.empty()) {
-            const std::string d = w->out + "/";
-            write_file_atomic(d + "sweep.csv", sweep.str());
-            write_file_atomic(d + "pores.csv", pore_csv.str());
-            write_file_atomic(d + "network.svg", network_svg(m, panels));
-            write_file_atomic(d + "pores.svg", histogram_svg(hist_names, hist_values, "pore equivalent diameter (seed units)"));
-            emit_json(j, d + "summary.json");
+        if (!dir.empty()) {
+            write_file_atomic(dir + "sweep.csv", sweep.str());
+            write_file_atomic(dir + "pores.csv", pore_csv.str());
+            write_file_atomic(dir + "network.svg", network_svg(m, panels));
+            write_file_atomic(dir + "pores.svg", histogram_svg(hist_names, hist_values, "pore equivalent diameter (seed units)"));
+            emit_json(j, dir + "summary.json");
         }
         emit_json(j);
         if (!ok) exit_code() = 1;

@@ -56,9 +56,10 @@ CapillaryLaw CapillaryLaw::read(const std::string& path) {
     int ln = 0;
     while (std::getline(is, line)) {
         ++ln;
-        auto p = line.find_first_not_of(" \t\r");
-        if (p == std::string::npos || line[p] == '#') continue;
-        std::istringstream ss(line);
+        // '#' starts a comment, also after a row's two numbers ("90 0 # end").
+        const std::string data = line.substr(0, line.find('#'));
+        if (data.find_first_not_of(" \t\r") == std::string::npos) continue;
+        std::istringstream ss(data);
         std::string ta, tv, extra;
         if (!(ss >> ta >> tv) || (ss >> extra))
             throw InputError(path + ":" + std::to_string(ln) + ": expected 'alpha_deg value', found '" + line + "'");

@@ -24,6 +24,9 @@ void Scene::check() const {
     if (wet.crossings != "fraction" && wet.fraction != 1)  // else silently ignored, yet reported in the summary
         throw InputError(source + ": [wet].fraction = " + show(wet.fraction) + " is used only with crossings = "
                          "fraction (crossings is '" + wet.crossings + "')");
+    if (wet.crossings != "fraction" && wet.seed != 1)  // the seed of that draw, likewise (--wet-seed)
+        throw InputError(source + ": [wet].seed = " + std::to_string(wet.seed) + " is used only with crossings = "
+                         "fraction (crossings is '" + wet.crossings + "')");
 }
 
 void Scene::check_values() const {

@@ -132,3 +132,19 @@ TEST_CASE("capillary: malformed tables are rejected naming the row and value", "
     CapillaryLaw::read(path).eval(0.5, phi, d, d2);
     CHECK(phi == Approx(-0.5));
 }
+
+TEST_CASE("capillary: a law file may end a row with a comment", "[energy][capillary][input]") {
+    // docs/formats.md allows '#' comments; a trailing one ("90 0 # end") was read as a third field and refused.
+    const std::string path = "/tmp/fibernet_law_comment_test.txt";
+    std::ofstream(path) << "# alpha value\n0 -1   # aligned\n90 0 # end\n";
+    double phi, d, d2;
+    CapillaryLaw::read(path).eval(0.5, phi, d, d2);
+    CHECK(phi == Approx(-0.5));
+    // A comment does not stand in for a missing value, and '#' inside a number is no comment.
+    std::ofstream(path) << "0 -1\n90 # 0\n";
+    CHECK_THROWS_WITH(CapillaryLaw::read(path), Catch::Contains(path + ":2"));
+    std::ofstream(path) << "0 -1\n90 0#\n";
+    CHECK_NOTHROW(CapillaryLaw::read(path));
+    std::ofstream(path) << "0 -1\n90 0x# c\n";
+    CHECK_THROWS_WITH(CapillaryLaw::read(path), Catch::Contains(path + ":2"));
+}

@@ -10,6 +10,13 @@
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <chrono>
+#include <csignal>
+#include <fcntl.h>
+#include <filesystem>
+#include <functional>
+#include <thread>
+#include <nlohmann/json.hpp>
 
 namespace {
 using clitest::exists;
@@ -17,6 +24,51 @@ using clitest::slurp;
 using clitest::tmpdir;
 using clitest::write;
 int run(const std::string& args) { return clitest::run("wet " + args); }
+
+// `fibernet wet ARGS` in the background (its own pid, so a signal reaches it and not a shell), stdout and stderr in
+// tmpdir()/bg_stdout and bg_stderr.
+pid_t start(const std::vector<std::string>& args) {
+    const pid_t pid = fork();
+    if (pid == 0) {
+        const int o = open((tmpdir() + "/bg_stdout").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        const int e = open((tmpdir() + "/bg_stderr").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        dup2(o, 1), dup2(e, 2);
+        std::signal(SIGINT, SIG_DFL);  // a test run in the background of a script inherits SIGINT ignored
+        std::vector<char*> argv{const_cast<char*>(FIBERNET_EXE), const_cast<char*>("wet")};
+        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(FIBERNET_EXE, argv.data());
+        _exit(127);
+    }
+    return pid;
+}
+
+// Polls until `ready` holds while the process still runs (true), or it exits or 300 s pass (false; a run still
+// going is killed).
+bool wait_until(pid_t pid, const std::function<bool()>& ready) {
+    const auto t0 = std::chrono::steady_clock::now();
+    while (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(300)) {
+        if (ready()) return true;
+        if (waitpid(pid, nullptr, WNOHANG) == pid) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    kill(pid, SIGKILL);
+    waitpid(pid, nullptr, 0);
+    return false;
+}
+
+nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(slurp(path), nullptr, false); }
+
+int lines(const std::string& path) {
+    const std::string t = slurp(path);
+    return static_cast<int>(std::count(t.begin(), t.end(), '\n'));
+}
+
+bool any_tmp(const std::string& dir) {
+    for (const auto& f : std::filesystem::directory_iterator(dir))
+        if (f.path().extension() == ".tmp") return true;
+    return false;
+}
 }  // namespace
 
 TEST_CASE("cli wet: a small run writes its documented outputs", "[wet][cli]") {
@@ -106,7 +158,14 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
                           Case{"--modulus-strain nan", "modulus strain = nan"},
                           Case{"--modulus-strain 0", "modulus strain = 0"},
                           Case{"--modulus-strain 0.2", "modulus strain = 0.2"},
-                          Case{"--modulus-strain 1e-4 --no-moduli", "--modulus-strain given with --no-moduli"}}) {
+                          Case{"--modulus-strain 1e-4 --no-moduli", "--modulus-strain given with --no-moduli"},
+                          // The draw's seed is as unused as its fraction without crossings = fraction.
+                          Case{"--wet-seed 5", "[wet].seed = 5 is used only with crossings = fraction"},
+                          Case{"--crossings free --wet-seed 5", "[wet].seed = 5 is used only with crossings = fraction"},
+                          // An empty entry was dropped: 0,,0.1 ran two betas.
+                          Case{"--betas 0,,0.1", "--betas '0,,0.1': entry 2 is empty"},
+                          Case{"--betas 0,0.1,", "--betas '0,0.1,': entry 3 is empty"},
+                          Case{"--betas 0,abc", "--betas '0,abc': entry 2, 'abc', is not a number"}}) {
         INFO(c.args);
         CHECK(run("--L 2.5 --q 5 " + c.args + " -o " + out) == 2);
         CHECK(slurp(tmpdir() + "/stderr").find(c.needle) != std::string::npos);
@@ -149,4 +208,107 @@ TEST_CASE("cli wet: --free-box reports the zero-stress box, and exit 1 when it i
     const std::string k = slurp(tmpdir() + "/stdout");
     CHECK(k.find("\"converged\": false") != std::string::npos);
     CHECK(k.find("\"status\": \"free_box_not_converged\"") != std::string::npos);
+}
+
+TEST_CASE("cli wet: summary.json records what reproduces the run", "[wet][cli]") {
+    const std::string out = tmpdir() + "/record", law = tmpdir() + "/record_law.txt", scene = tmpdir() + "/record.toml";
+    REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
+    const std::string law_text = "# E/(beta l)\n0 -1\n45 -0.5\n90 0\n";
+    write(law, law_text);
+    // Every [wet] setting away from its default, so that each recorded value is this run's.
+    write(scene, "[network]\nL = 2.5\nq = 8\npl = 1\nseed = 3\n[wet]\ncrossings = \"fraction\"\nfraction = 0.5\n"
+                 "max_rounds = 50\nround_iterations = 0\nnewton_ldl = false\nlocal_fraction = 0\n"
+                 "local_threshold = 0.2\nlocal_hops = 1\n");
+    REQUIRE(run(scene + " --wet-seed 5 --law " + law + " --betas 0,0 --no-moduli -q -o " + out) == 0);
+    const nlohmann::json j = read_json(out + "/summary.json");
+    REQUIRE(j.is_object());
+    const nlohmann::json& w = j["wet"];
+    INFO(w.dump(2));
+    CHECK(w["seed"] == 5);
+    CHECK(w["fraction"] == 0.5);
+    CHECK(w["max_rounds"] == 50);
+    CHECK(w["round_iterations"] == 0);
+    CHECK(w["newton_ldl"] == false);
+    CHECK(w["local_fraction"] == 0.0);
+    CHECK(w["local_threshold"] == 0.2);
+    CHECK(w["local_hops"] == 1);
+    CHECK(w["betas"] == nlohmann::json::array({0.0, 0.0}));  // the list asked for, also before any run finished
+    CHECK(w["law"] == law);
+    CHECK(w["law_table"] == law_text);  // the table itself: the file may change or be gone
+    CHECK(w["law_fnv1a"].is_number_unsigned());
+    CHECK(w["moduli"] == false);
+    CHECK(j["solver"] == nlohmann::json({{"name", "newton"}, {"tol", 1e-10}, {"max_iter", 500}}));
+    CHECK(j["prune"] == nlohmann::json::array());
+    CHECK(j["parameters"]["seed"] == 3);
+    // The default law is named, with no table.
+    REQUIRE(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0 --no-moduli -q -o " + out) == 0);
+    const nlohmann::json d = read_json(out + "/summary.json");
+    CHECK(d["wet"]["law"] == "cos2");
+    CHECK(d["wet"]["law_table"].is_null());
+    CHECK(d["wet"]["seed"].is_null());  // no draw: crossings = all
+    CHECK(d["wet"]["betas"] == nlohmann::json::array({0.0}));
+}
+
+TEST_CASE("cli wet: a re-run invalidates the old results, and SIGINT keeps the finished betas", "[wet][cli][signal]") {
+    const std::string out = tmpdir() + "/rerun";
+    REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
+    const std::string quick = "--L 2.5 --q 8 --pl 1 --seed 3 --beta 0 --no-moduli -q -o " + out;
+    // A new network (L = 5) whose wet beta takes seconds: the signal comes while it runs.
+    auto is_new = [&](const nlohmann::json& j) { return j.is_object() && j["parameters"]["L"] == 5.0; };
+
+    SECTION("interrupted in the second beta: the first is kept, on disk and on stdout") {
+        REQUIRE(run(quick) == 0);  // an old, complete result with its pictures
+        REQUIRE(exists(out + "/network.svg"));
+        const pid_t pid = start({"--L", "5", "--q", "10", "--seed", "3", "--betas", "0,0.05", "--no-moduli", "-o", out});
+        REQUIRE(wait_until(pid, [&] {
+            const nlohmann::json j = read_json(out + "/summary.json");
+            return is_new(j) && j["runs"].size() == 1;
+        }));
+        kill(pid, SIGINT);
+        int st = 0;
+        REQUIRE(waitpid(pid, &st, 0) == pid);
+        REQUIRE(WIFEXITED(st));  // not killed by the signal
+        CHECK(WEXITSTATUS(st) == 130);
+        CHECK(slurp(tmpdir() + "/bg_stderr").find("wet: interrupted during beta = 0.05 (2 of 2)") != std::string::npos);
+        const nlohmann::json j = read_json(out + "/summary.json");
+        CHECK(is_new(j));
+        CHECK(j["complete"] == false);
+        REQUIRE(j["runs"].size() == 1);
+        CHECK(j["runs"][0]["beta"] == 0.0);
+        const nlohmann::json o = read_json(tmpdir() + "/bg_stdout");  // the finished betas reported
+        REQUIRE(o.is_object());
+        CHECK(o["complete"] == false);
+        CHECK(o["interrupted"] == true);
+        CHECK(o["runs"].size() == 1);
+        CHECK(lines(out + "/sweep.csv") == 2);  // header and beta 0
+        CHECK(slurp(out + "/pores.csv").find("wet,0,") != std::string::npos);
+        // The old run's pictures are gone rather than left beside tables they do not show.
+        CHECK(!exists(out + "/network.svg"));
+        CHECK(!exists(out + "/pores.svg"));
+        CHECK(!any_tmp(out));
+    }
+    SECTION("interrupted in the first beta: the old results were invalidated at the start") {
+        REQUIRE(run(quick) == 0);
+        REQUIRE(exists(out + "/pores.svg"));
+        const pid_t pid = start({"--L", "5", "--q", "10", "--seed", "3", "--betas", "0.05", "--no-moduli", "-q", "-o", out});
+        REQUIRE(wait_until(pid, [&] { return is_new(read_json(out + "/summary.json")); }));
+        const nlohmann::json j = read_json(out + "/summary.json");
+        CHECK(j["complete"] == false);
+        CHECK(j["runs"].empty());
+        CHECK(j["wet"]["betas"] == nlohmann::json::array({0.05}));
+        CHECK(!exists(out + "/network.svg"));
+        CHECK(!exists(out + "/pores.svg"));
+        CHECK(lines(out + "/sweep.csv") == 1);  // the old rows are gone: header only
+        CHECK(lines(out + "/pores.csv") == 1);
+        kill(pid, SIGINT);
+        int st = 0;
+        REQUIRE(waitpid(pid, &st, 0) == pid);
+        REQUIRE(WIFEXITED(st));
+        CHECK(WEXITSTATUS(st) == 130);
+        // -q silences progress, not the interrupt's message.
+        CHECK(slurp(tmpdir() + "/bg_stderr").find("wet: interrupted during beta = 0.05 (1 of 1)") != std::string::npos);
+        CHECK(read_json(out + "/summary.json")["runs"].empty());
+        CHECK(read_json(tmpdir() + "/bg_stdout")["runs"].empty());
+        CHECK(!any_tmp(out));
+    }
 }

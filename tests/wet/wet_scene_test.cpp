@@ -42,6 +42,11 @@ TEST_CASE("wet scene: values are read and bad ones named", "[wet][scene]") {
     CHECK_THROWS_WITH(fr.check(), Catch::Contains("fr.toml: [wet].fraction = 0.5 is used only with crossings = fraction"));
     fr.wet.crossings = "fraction";
     CHECK_NOTHROW(fr.check());
+    // The same for the seed of that draw: without crossings = fraction it changes nothing.
+    Scene sd = parse_scene("[wet]\nseed = 7\n", "sd.toml");
+    CHECK_THROWS_WITH(sd.check(), Catch::Contains("sd.toml: [wet].seed = 7 is used only with crossings = fraction"));
+    sd.wet.crossings = "fraction";
+    CHECK_NOTHROW(sd.check());
     struct Bad {
         std::string toml, needle;
     };

@@ -2,6 +2,7 @@
 // A scene (docs/formats.md, "scene"; files in problems/) says what is asked: which network, how to discretize it,
 // what load, which solver. TOML; every key is optional and has the default shown in docs/formats.md.
 // Command-line flags override a scene's values.
+#include <cstdint>
 #include <string>
 #include <vector>
 
