@@ -165,7 +165,8 @@ nlohmann::json pore_json(const PoreStats& p) {
     const double n = static_cast<double>(p.pores.size());
     return {{"count", p.pores.size()}, {"mean_area", n ? num(sum / n) : nlohmann::json()},
             {"mean_diameter", n ? num(dsum / n) : nlohmann::json()}, {"largest_area", amax},
-            {"remainder_area", p.remainder}, {"box_area", p.box_area}, {"open_cycles", p.open_cycles}};
+            {"remainder_area", p.remainder}, {"box_area", p.box_area}, {"open_cycles", p.open_cycles},
+            {"islands", p.islands}};
 }
 
 nlohmann::json energy_json(const WetSplit& e) {
