@@ -1,6 +1,7 @@
 // fibernet modulus: equilibrium at the scene's strain, then the linear shear and bulk moduli from one
 // factorization (docs/moduli.md), normalised by the affine prediction. Exit 1 (JSON with status, moduli null)
 // when the equilibrium or the modulus solve did not converge.
+#include <algorithm>
 #include <chrono>
 
 #include "common.hpp"
@@ -84,7 +85,8 @@ void register_modulus(CLI::App& app) {
             ModuliInfo info;
             auto* newton = dynamic_cast<NewtonSolver*>(solver.get());  // reuse its symbolic analysis
             ModuliOptions mo;
-            mo.equilibrium_tol = std::max(mo.equilibrium_tol, s.solver.tol);  // what the solver accepted
+            // What the solver accepted (tol, or Newton's round-off floor, measured on the Hessian it used).
+            mo.equilibrium_tol = std::max({mo.equilibrium_tol, s.solver.tol, eq.result.grad_max});
             const auto mods = linear_moduli(e, eq.q, F, modes, mo, &info, newton ? newton->factorization() : nullptr);
             moduli = nlohmann::json::object();
             for (const auto& M : mods) {

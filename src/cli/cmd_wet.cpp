@@ -125,7 +125,7 @@ std::vector<double> parse_betas(const std::vector<std::string>& lists) {
             char* end = nullptr;
             const double v = std::strtod(t.c_str(), &end);
             if (*end) throw InputError(where + ": entry " + std::to_string(entry) + ", '" + t + "', is not a number");
-            check_value(v >= 0, v, where, "beta", "must be >= 0");
+            check_value(v >= 0 && std::isfinite(v), v, where, "beta", "must be finite and >= 0");
             betas.push_back(v);
             if (comma == std::string::npos) break;
             start = comma + 1;
@@ -422,9 +422,10 @@ void register_wet(CLI::App& app) {
                         if (ec) throw InputError("--out-dir '" + w->out + "': cannot remove the previous " + f + " (" +
                                                  ec.message() + ")");
                     }
-                emit_json(summary(false), dir + "summary.json");
+                // The tables first, the summary last: a summary never lists a beta whose rows are not written yet.
                 write_file_atomic(dir + "sweep.csv", sweep.str());
                 write_file_atomic(dir + "pores.csv", pore_csv.str());
+                emit_json(summary(false), dir + "summary.json");
             }
             nlohmann::json r = summary(false);
             r["interrupted"] = true;

@@ -71,7 +71,8 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
                       "not an equilibrium: max|g| = %.3g above max(equilibrium_tol %.3g, round-off floor %.3g); linear "
                       "moduli hold at an equilibrium only",
                       gmax, opt.equilibrium_tol, floor);
-        for (auto& M : out) M.value = M.error = std::numeric_limits<double>::quiet_NaN(), M.ok = false;
+        for (auto& M : out)
+            M.value = M.error = M.affine = std::numeric_limits<double>::quiet_NaN(), M.ok = false;
         inf.message = buf;
         inf.grad_max = gmax, inf.grad_floor = floor;
         inf.seconds_total = since(t_start);

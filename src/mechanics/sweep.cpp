@@ -1,5 +1,7 @@
 #include "fibernet/mechanics/sweep.hpp"
 
+#include <algorithm>
+
 #include <chrono>
 #include <cmath>
 
@@ -65,13 +67,15 @@ Response respond(const NetworkEnergy& e, const Eigen::VectorXd& q, double t, Str
 SweepOutcome run_sweep(const NetworkEnergy& e, const SweepParams& p, Solver& solver, const SweepCallbacks& cb,
                        const SweepState* resume, Solver* snap) {
     p.check("sweep");
+    // The tolerance a state of this sweep was accepted at (the corrector may be the snap solver).
+    const double accepted_tol = std::max(solver.options().tol, snap ? snap->options().tol : 0.0);
     SweepOutcome out;
     const double dir = p.t_max > 0 ? 1 : -1;
     SweepState s;
     Response resp;
     if (resume) {
         s = *resume;
-        resp = respond(e, s.q, s.t, p.kind, solver.options().tol);
+        resp = respond(e, s.q, s.t, p.kind, accepted_tol);
         if (!resp.ok) {
             out.message = "linear response failed at the resumed state: " + resp.message;
             return out;
@@ -84,7 +88,7 @@ SweepOutcome run_sweep(const NetworkEnergy& e, const SweepParams& p, Solver& sol
             return out;
         }
         s.q = eq.q, s.t = 0, s.step = 0, s.next_step = p.step;
-        resp = respond(e, s.q, 0, p.kind, solver.options().tol);
+        resp = respond(e, s.q, 0, p.kind, accepted_tol);
         if (!resp.ok) {
             out.message = "linear response failed at t = 0: " + resp.message;
             return out;
@@ -121,7 +125,7 @@ SweepOutcome run_sweep(const NetworkEnergy& e, const SweepParams& p, Solver& sol
             // and the solver found the next stable state, which is what a quasistatic experiment does too.
             const bool slow = eq.result.iterations > p.max_iterations && 0.5 * h >= p.min_step;
             if (eq.converged() && !slow) {
-                Response r = respond(e, eq.q, t_new, p.kind, solver.options().tol);
+                Response r = respond(e, eq.q, t_new, p.kind, std::max(accepted_tol, eq.result.grad_max));
                 if (r.ok) {
                     resp = std::move(r);
                     s.t = t_new;

@@ -10,6 +10,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <limits>
 #include <mutex>
 #include <numeric>
 #include <unordered_map>
@@ -237,9 +238,10 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
                          std::vector<Bridge>& bridges, const ActiveSetOptions& opt, const FiberPairs* frozen,
                          bool settled, const std::vector<char>* moved) {
     auto is_frozen = [&](int f1, int f2) { return frozen && frozen->count({std::min(f1, f2), std::max(f1, f2)}); };
-    // A pair frozen after a cycle or left dry by the wetting rule gets no new bridge.
-    auto closed = [&](int f1, int f2) {
-        return is_frozen(f1, f2) || (opt.dry_pairs && opt.dry_pairs->count({std::min(f1, f2), std::max(f1, f2)}));
+    // A pair whose network crossing the wetting rule left dry gets no crossing bridge (contacts of aligned segments
+    // form as for any pair: zipping fibers wet each other).
+    auto dry_pair = [&](int f1, int f2) {
+        return opt.dry_pairs && opt.dry_pairs->count({std::min(f1, f2), std::max(f1, f2)});
     };
     const Model& m = dry.model();
     const Eigen::VectorXd x = dry.positions(q, F);
@@ -432,7 +434,7 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
         const bool known = std::any_of(v.begin(), v.end(), [&](const std::pair<int, int>& h) {
             return std::abs(h.first - c.k1) <= 1 && std::abs(h.second - c.k2) <= 1;
         });
-        if (known || closed(c.f1, c.f2)) continue;
+        if (known || is_frozen(c.f1, c.f2) || dry_pair(c.f1, c.f2)) continue;
         // The move margin at fiber ends too: a crossing within it of an end forms no bridge. Such a bridge has under
         // half its weight, its crossing can slide off the end (rupture) and back in (form) on alternate rounds
         // (cycling; seen on a 100-fiber benchmark network).
@@ -453,7 +455,7 @@ WetEvents update_bridges(const NetworkEnergy& dry, const Eigen::VectorXd& q, con
         ++ev.formed;
     }
     for (const Bridge& c : contacts) {
-        if (partnered.count({c.f1, c.k1, c.f2}) || partnered.count({c.f2, c.k2, c.f1}) || closed(c.f1, c.f2)) continue;
+        if (partnered.count({c.f1, c.k1, c.f2}) || partnered.count({c.f2, c.k2, c.f1}) || is_frozen(c.f1, c.f2)) continue;
         if (!admit(c, true)) continue;
         note(c);
         bridges.push_back(c);
@@ -493,6 +495,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
         if (history.size() > kKeep) Signature().swap(history[history.size() - kKeep - 1]);
     };
     auto kept = [&](size_t i) { return i + kKeep >= history.size(); };
+    double stalled_g = std::numeric_limits<double>::infinity();  // max|g| of the last limit round that changed nothing
     FiberPairs frozen;
     // The solver's options, restored on return; rounds are capped below its budget while the set keeps changing.
     SolverOptions& so = solver.options();
@@ -700,15 +703,20 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
                          g_valid ? ("; whole network with the updated set " + format_g(gmax)).c_str() : "",
                          bridges.size(), ev.moves, ev.ruptures, ev.formed, ev.merged, ev.locked,
                          opt.bundle_partners > 0 ? (", capped " + std::to_string(ev.capped)).c_str() : "");
-        // A solve that used its whole iteration budget (not cut by the round cap) and left the set as it was: another
-        // round would only continue the same solve past the solver's max_iter (an L-BFGS run on a 90-fiber network ran
-        // 239 such rounds of 500 iterations, max|g| stuck at 0.06-0.17, towards max_rounds). The run ends unconverged.
-        if (limit && !capped && !local && sig == history.back()) {
-            r.message = "round " + std::to_string(round) + ": the solver stopped at its iteration limit (" +
-                        std::to_string(r.last.iterations) + " iterations, max|g| " + format_g(r.last.grad_max) +
-                        ") and the bridge set did not change: no equilibrium within max_iter";
+        // Solves that use their whole budget (not cut by the round cap) and leave the set as it was continue the same
+        // solve round after round; while max|g| halves from one such round to the next that is progress, but a solver
+        // that stalls would repeat towards max_rounds (an L-BFGS run on a 90-fiber network ran 239 rounds of 500
+        // iterations, max|g| stuck at 0.06-0.17). Two such rounds in a row without max|g| halving end the run
+        // unconverged.
+        const bool unchanged_limit = limit && !capped && !local && sig == history.back();
+        if (unchanged_limit && stalled_g < std::numeric_limits<double>::infinity() &&
+            !(r.last.grad_max <= 0.5 * stalled_g)) {
+            r.message = "round " + std::to_string(round) + ": the solver stopped at its limit again (" +
+                        r.last.message + ", max|g| " + format_g(r.last.grad_max) + " after " + format_g(stalled_g) +
+                        ") and the bridge set did not change: no progress towards an equilibrium";
             break;
         }
+        stalled_g = unchanged_limit ? r.last.grad_max : std::numeric_limits<double>::infinity();
         if (equilibrium) {
             r.stable = true;
             r.message = "stable after " + std::to_string(round) + " round(s)" +

@@ -52,8 +52,10 @@ PoreStats pores(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d&
     for (int i = 0; i < nn; ++i) {
         Eigen::Vector2d u = Bi * x.segment<2>(2 * i);
         if (m.box.periodic) u = u.array() - u.array().floor();
-        const auto k = std::make_pair(std::llround(u.x() / snap) % std::llround(1 / snap),
-                                      std::llround(u.y() / snap) % std::llround(1 / snap));
+        // Wrapped (u = 1 is u = 0) in a periodic box only: in an open one, nodes at 0 and at 1 are different points.
+        const long long period = m.box.periodic ? std::llround(1 / snap) : 0;
+        auto cell = [&](double c) { return period ? std::llround(c / snap) % period : std::llround(c / snap); };
+        const auto k = std::make_pair(cell(u.x()), cell(u.y()));
         auto it = at.find(k);
         if (it != at.end()) {
             vert[i] = it->second;
@@ -215,7 +217,8 @@ PoreStats pores(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d&
         Face* best = nullptr;
         for (Face& f : faces) {
             if (find(comp, half[f.h0].from) == c || (best && f.area >= best->area)) continue;
-            bool in = !m.box.periodic && inside(f.poly, pos[v]);
+            bool in = !m.box.periodic && (u.array() >= f.lo.array()).all() && (u.array() <= f.hi.array()).all() &&
+                      inside(f.poly, pos[v]);
             if (m.box.periodic)
                 for (int ny = static_cast<int>(std::ceil(f.lo.y() - u.y())); !in && ny <= f.hi.y() - u.y(); ++ny)
                     for (int nx = static_cast<int>(std::ceil(f.lo.x() - u.x())); !in && nx <= f.hi.x() - u.x(); ++nx)

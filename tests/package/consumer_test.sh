@@ -9,7 +9,7 @@ tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
 cmake --install "$build" --prefix "$tmp/prefix" > "$tmp/install.log" || { cat "$tmp/install.log"; fail "cmake --install"; }
-libdir=$(ls -d "$tmp"/prefix/lib*/cmake/fibernet 2>/dev/null | head -1)
+libdir=$(ls -d "$tmp"/prefix/lib*/cmake/fibernet 2>/dev/null | head -1 || true)
 for f in bin/fibernet include/fibernet/mechanics/moduli.hpp include/fibernet/wet/wet_run.hpp; do
   [ -e "$tmp/prefix/$f" ] || fail "not installed: $f"
 done

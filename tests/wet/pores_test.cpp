@@ -121,12 +121,11 @@ TEST_CASE("pores: an island in a cell that wraps through the periodic box", "[we
     const Model m = model_of(network_of(lines, 1.0), 10);
     const PoreStats p = pores(m, m.x, m.box.B0());
     REQUIRE(p.pores.size() == 9);  // 8 cells and the triangle
-    double sum = 0, smallest = 1e300;
-    for (const auto& q : p.pores) sum += q.area, smallest = std::min(smallest, q.area);
+    double smallest = 1e300;
+    for (const auto& q : p.pores) smallest = std::min(smallest, q.area);
     CHECK(smallest == Approx(tri).epsilon(1e-10));
     CHECK(p.islands == 1);
     CHECK(p.remainder == Approx(100 * 0.32 * 0.37 - tri).epsilon(1e-10));
-    CHECK(sum + p.remainder == Approx(p.box_area).epsilon(1e-14));
 }
 
 TEST_CASE("pores: two fibers zipped on top of each other across a square", "[wet][pores]") {
@@ -167,9 +166,6 @@ TEST_CASE("pores: zipped fiber pairs in a Mikado network leave no area out", "[w
     net.crossings = find_crossings(net);
     const Model m = model_of(net, 10);
     const PoreStats p = pores(m, m.x, m.box.B0());
-    double sum = 0;
-    for (const auto& q : p.pores) sum += q.area;
     CHECK(p.open_cycles == 0);
     CHECK(std::abs(p.remainder) < 1e-9 * p.box_area);
-    CHECK(sum + p.remainder == Approx(p.box_area).epsilon(1e-14));
 }

@@ -21,7 +21,8 @@
 // when the solver fails, or after max_rounds. A repeat is first broken: the fiber pairs whose bridges toggle are frozen (their bridges kept as they
 // are, no new ones) and the rounds go on, so the result is an equilibrium with a set that obeys the rules everywhere
 // but on those pairs (counted: cycles_broken, frozen_pairs). A solve that
-// hits its iteration limit is not a failure: the set is updated and the next round continues from there. While the
+// hits its iteration limit is not a failure: the set is updated and the next round continues from there, unless two
+// such rounds in a row (uncut, the set unchanged) did not halve max|g|: then the run ends unconverged. While the
 // set keeps changing, rounds are cut at round_iterations on purpose (events interleaved with the solve).
 // Local rounds (local_fraction > 0, beta > 0): when the part of the network that needs a solve is small, a round
 // solves only that part, each connected piece on its own with the rest held (wet_region.hpp), and updates the set only
@@ -83,8 +84,9 @@ struct ActiveSetOptions {
     // 2: a flat ribbon (each fiber between two neighbours); 6: a close-packed 3D bundle. 0: no cap (2D stacking
     // unbounded: a bundle of k fibers on one line holds k(k-1)/2 adhering pairs; docs/wet.md, "Bundle partners").
     int bundle_partners = 0;
-    // Fiber pairs whose network crossing the wetting rule left dry (wetting.hpp, dry_pairs): no bridge of any kind
-    // forms between them, since their crossing moves with the fibers and stays dry. Null: every crossing is wet.
+    // Fiber pairs whose network crossing the wetting rule left dry (wetting.hpp, dry_pairs): no crossing bridge forms
+    // between them, since their crossing moves with the fibers and stays dry (contacts of aligned segments still form,
+    // as for any pair). Null: every crossing is wet. run_wet sets it from WettingRule.
     std::shared_ptr<const FiberPairs> dry_pairs;
 };
 

@@ -32,8 +32,8 @@ Bridge make_bridge(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix
 std::vector<char> wet_choice(const Network& net, const WettingRule& rule);
 
 // The fiber pairs of the crossings the rule leaves dry. A crossing moves with its fibers, so a dry one stays dry:
-// the active set forms no bridge between such a pair (ActiveSetOptions::dry_pairs); without this, the first update
-// gave every free crossing a bridge again, whatever the fraction.
+// the active set forms no crossing bridge between such a pair (ActiveSetOptions::dry_pairs); without this, the first
+// update gave every free crossing a bridge again, whatever the fraction.
 FiberPairs dry_pairs(const Network& net, const WettingRule& rule);
 
 // One bridge per wet network crossing, on the segments that contain it (a crosslink's supernode starts both homes),
