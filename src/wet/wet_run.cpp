@@ -64,6 +64,11 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
         throw InputError("run_wet: the model (" + std::to_string(m.chains.size()) + " fibers, " +
                          std::to_string(m.crossing_node.size()) + " crossings) was not discretized from this network (" +
                          std::to_string(net.fibers.size()) + " fibers, " + std::to_string(net.crossings.size()) + ")");
+    for (size_t k = 0; k < net.crossings.size(); ++k)  // same counts, other crosslinks (another pl): still another network
+        if ((m.crossing_node[k] >= 0) != net.crossings[k].crosslink)
+            throw InputError("run_wet: crossing " + std::to_string(k) + " is " +
+                             (net.crossings[k].crosslink ? "a crosslink" : "free") + " in the network but not in the model: "
+                             "the model was not discretized from this network");
     for (size_t f = 0; f < m.chains.size(); ++f) {
         const FiberChain& ch = m.chains[f];
         const double len = net.fibers[f].length * m.fiber_length;

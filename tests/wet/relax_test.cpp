@@ -232,6 +232,10 @@ TEST_CASE("run_wet refuses what the CLI refuses, and computes no modulus for an 
     // A model of another network (before: thousands of bogus bridges).
     const Model other = model_of(mikado(3.0, 10, 0.5, 3), 10);
     CHECK_THROWS_WITH(run_wet(net, other, Eigen::Matrix2d::Identity(), opt), Catch::Contains("not discretized from"));
+    // The same fibers and crossings with other crosslinks (another pl draws other ones from the same seed).
+    const Model other_pl = model_of(mikado(3.0, 10, 0.8, 2), 10);
+    REQUIRE(other_pl.crossing_node.size() == net.crossings.size());
+    CHECK_THROWS_WITH(run_wet(net, other_pl, Eigen::Matrix2d::Identity(), opt), Catch::Contains("not discretized from"));
     // The free box of an open network (before: "converged after 0 iterations", a meaningless s = 1).
     MikadoParams mp;
     mp.L = 3, mp.q = 10, mp.pl = 0.5, mp.seed = 2, mp.periodic = false;
