@@ -41,10 +41,7 @@ std::string csv_row(const SweepRow& r) {
 nlohmann::json sweep_parameters(const Scene& s, const SweepParams& p) {
     nlohmann::json j = scene_parameters(s);
     if (!s.network_file.empty()) {  // the file's content, not only its name, makes the network
-        std::ifstream is(s.network_file, std::ios::binary);
-        std::uint64_t h = kFnvOffset;
-        for (char c; is.get(c);) h = fnv1a(h, static_cast<unsigned char>(c));
-        j["network_file_fnv1a"] = h;
+        j["network_file_fnv1a"] = fnv1a_bytes(file_bytes(s.network_file, "network file"));
         // The file by its canonical path: the same file named from another directory or as ./x.net is the same sweep.
         std::error_code ec;
         const std::filesystem::path canon = std::filesystem::weakly_canonical(s.network_file, ec);

@@ -134,20 +134,6 @@ std::vector<double> parse_betas(const std::vector<std::string>& lists) {
     return betas;
 }
 
-// The bytes of a file the run depends on (a law table), for the summary; throws InputError if unreadable.
-std::string file_text(const std::string& path, const std::string& what) {
-    std::ifstream is(path, std::ios::binary);
-    std::ostringstream os;
-    if (!is || !(os << is.rdbuf())) throw InputError(what + " '" + path + "' cannot be read");
-    return os.str();
-}
-
-std::uint64_t fnv1a_text(const std::string& text) {
-    std::uint64_t h = kFnvOffset;
-    for (unsigned char c : text) h = fnv1a(h, c);
-    return h;
-}
-
 // This process's arguments (Linux /proc), so a summary says how it was made; null where /proc is missing.
 nlohmann::json command_line() {
     std::ifstream is("/proc/self/cmdline", std::ios::binary);
@@ -307,10 +293,10 @@ void register_wet(CLI::App& app) {
         std::string law_text;  // recorded in the summary: the file may change or go
         if (!s.wet.law.empty()) {
             opt.params.law = CapillaryLaw::read(s.wet.law);
-            law_text = file_text(s.wet.law, "capillary law file");
+            law_text = file_bytes(s.wet.law, "capillary law file");
         }
         std::string network_text;
-        if (!s.network_file.empty()) network_text = file_text(s.network_file, "network file");
+        if (!s.network_file.empty()) network_text = file_bytes(s.network_file, "network file");
         opt.rule.which = parse_wet_which(s.wet.crossings);
         opt.rule.fraction = s.wet.fraction, opt.rule.seed = s.wet.seed;
         opt.solver = s.solver.name;
@@ -371,13 +357,13 @@ void register_wet(CLI::App& app) {
         // Everything the results depend on (docs/formats.md, "Wet scenes": summary.json), so that a run can be
         // repeated and a rerun told apart from it (bench/run_wet_pores.sh compares them before it skips a seed).
         nlohmann::json parameters = scene_parameters(s);  // which network the summary describes
-        if (!s.network_file.empty()) parameters["network_file_fnv1a"] = fnv1a_text(network_text);
+        if (!s.network_file.empty()) parameters["network_file_fnv1a"] = fnv1a_bytes(network_text);
         const bool fraction = s.wet.crossings == "fraction";
         const nlohmann::json wet_settings = {
             {"betas", betas},
             {"law", s.wet.law.empty() ? "cos2" : s.wet.law},
             {"law_table", s.wet.law.empty() ? nlohmann::json() : nlohmann::json(law_text)},
-            {"law_fnv1a", s.wet.law.empty() ? nlohmann::json() : nlohmann::json(fnv1a_text(law_text))},
+            {"law_fnv1a", s.wet.law.empty() ? nlohmann::json() : nlohmann::json(fnv1a_bytes(law_text))},
             {"crossings", s.wet.crossings},
             {"fraction", s.wet.fraction},
             {"seed", fraction ? nlohmann::json(s.wet.seed) : nlohmann::json()},  // no draw otherwise

@@ -10,7 +10,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/util/error.hpp"
@@ -176,6 +178,13 @@ nlohmann::json to_json(const ModelSummary& s) {
             {"supernodes", s.supernodes}, {"fibers", s.fibers},
             {"shortest_segment", s.shortest_segment}, {"longest_segment", s.longest_segment},
             {"mean_segment", s.mean_segment}};
+}
+
+std::string file_bytes(const std::string& path, const std::string& what) {
+    std::ifstream is(path, std::ios::binary);
+    std::ostringstream os;
+    if (!is || !(os << is.rdbuf())) throw InputError(what + " '" + path + "' cannot be read");
+    return os.str();
 }
 
 void emit_json(const nlohmann::json& j, const std::string& path) {

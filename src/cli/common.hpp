@@ -71,6 +71,9 @@ nlohmann::json to_json(const ModelSummary& s);
 
 // Prints JSON to stdout (or to `path` atomically when non-empty).
 void emit_json(const nlohmann::json& j, const std::string& path = "");
+// The bytes of a file a result depends on (a network file, a law table), e.g. for its fingerprint (util/hash.hpp);
+// InputError naming `what` and the path if it cannot be read.
+std::string file_bytes(const std::string& path, const std::string& what);
 
 double seconds_since(const std::chrono::steady_clock::time_point& t0);
 

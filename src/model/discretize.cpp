@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 #include "fibernet/util/error.hpp"
+#include "fibernet/util/union_find.hpp"
 
 namespace fibernet {
 
@@ -26,19 +26,6 @@ void DiscretizationParams::check(const std::string& where) const {
 }
 
 namespace {
-struct UnionFind {
-    std::vector<int> p;
-    explicit UnionFind(int n) : p(n) { std::iota(p.begin(), p.end(), 0); }
-    int find(int i) {
-        while (p[i] != i) i = p[i] = p[p[i]];
-        return i;
-    }
-    void unite(int a, int b) {
-        a = find(a), b = find(b);
-        if (a != b) p[std::max(a, b)] = std::min(a, b);
-    }
-};
-
 struct Pin {
     double s;      // arc position in seed units
     int crossing;

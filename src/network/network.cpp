@@ -1,7 +1,8 @@
 #include "fibernet/network/network.hpp"
 
 #include <algorithm>
-#include <numeric>
+
+#include "fibernet/util/union_find.hpp"
 
 namespace fibernet {
 
@@ -24,21 +25,6 @@ bool intersect(const Eigen::Vector2d& a0, const Eigen::Vector2d& ua, double la, 
 bool intersect(const Fiber& a, const Fiber& b, const Eigen::Vector2d& shift, double& sa, double& sb) {
     return intersect(a.start, a.direction(), a.length, b.start + shift, b.direction(), b.length, sa, sb);
 }
-
-namespace {
-struct UnionFind {
-    std::vector<int> parent;
-    explicit UnionFind(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-    int find(int i) {
-        while (parent[i] != i) i = parent[i] = parent[parent[i]];
-        return i;
-    }
-    void unite(int a, int b) {
-        a = find(a), b = find(b);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
-};
-}  // namespace
 
 std::vector<int> crosslink_components(const Network& net) {
     const int n = static_cast<int>(net.fibers.size());

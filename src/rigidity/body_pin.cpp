@@ -4,15 +4,11 @@
 #include <numeric>
 
 #include "fibernet/util/error.hpp"
+#include "fibernet/util/union_find.hpp"
 
 namespace fibernet {
 
 namespace {
-
-int find(std::vector<int>& p, int i) {
-    while (p[i] != i) i = p[i] = p[p[i]];
-    return i;
-}
 
 // Pins from the crosslinks of an open network; crosslinks closer than 1e-12 fiber lengths on one fiber are
 // one pin (the same tolerance discretize() uses to merge them into one supernode).
@@ -34,16 +30,14 @@ void add_crosslink_pins(const Network& net, BodyPinFramework& fw) {
         on_fiber[fill[c.f1]++] = {c.s1, k};
         on_fiber[fill[c.f2]++] = {c.s2, k};
     }
-    std::vector<int> parent(nc);
-    std::iota(parent.begin(), parent.end(), 0);
+    UnionFind pins(nc);
     bool any_merged = false;
     for (int f = 0; f < nf; ++f) {
         auto b = on_fiber.begin() + start[f], e = on_fiber.begin() + start[f + 1];
         std::sort(b, e);
         for (auto it = b; it != e && it + 1 != e; ++it)
             if ((it + 1)->first - it->first <= 1e-12) {
-                const int x = find(parent, it->second), y = find(parent, (it + 1)->second);
-                if (x != y) parent[std::max(x, y)] = std::min(x, y), any_merged = true;
+                if (pins.unite(it->second, (it + 1)->second)) any_merged = true;
             }
     }
     if (!any_merged) {  // the generic case: one pin per crosslink
@@ -58,7 +52,7 @@ void add_crosslink_pins(const Network& net, BodyPinFramework& fw) {
     }
     std::vector<std::vector<int>> members(nc);
     for (int k = 0; k < nc; ++k)
-        if (net.crossings[k].crosslink) members[find(parent, k)].push_back(k);
+        if (net.crossings[k].crosslink) members[pins.find(k)].push_back(k);
     for (int r = 0; r < nc; ++r) {
         if (members[r].empty()) continue;
         std::vector<int> bodies;

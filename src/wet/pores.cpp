@@ -4,19 +4,14 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numeric>
 
+#include "fibernet/util/union_find.hpp"
 #include "fibernet/wet/active_set.hpp"
 
 namespace fibernet {
 
 namespace {
 double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-int find(std::vector<int>& p, int v) {
-    while (p[v] != v) v = p[v] = p[p[v]];
-    return v;
-}
 
 // Crossing number of point q against the closed polygon poly.
 bool inside(const std::vector<Eigen::Vector2d>& poly, const Eigen::Vector2d& q) {
@@ -49,12 +44,12 @@ PoreStats pores(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d&
     std::map<std::pair<long long, long long>, int> at;
     int nv = 0;
     const double snap = 1e-9;
+    // Wrapped (u = 1 is u = 0) in a periodic box only: in an open one, nodes at 0 and at 1 are different points.
+    const long long period = m.box.periodic ? std::llround(1 / snap) : 0;
+    auto cell = [&](double c) { return period ? std::llround(c / snap) % period : std::llround(c / snap); };
     for (int i = 0; i < nn; ++i) {
         Eigen::Vector2d u = Bi * x.segment<2>(2 * i);
         if (m.box.periodic) u = u.array() - u.array().floor();
-        // Wrapped (u = 1 is u = 0) in a periodic box only: in an open one, nodes at 0 and at 1 are different points.
-        const long long period = m.box.periodic ? std::llround(1 / snap) : 0;
-        auto cell = [&](double c) { return period ? std::llround(c / snap) % period : std::llround(c / snap); };
         const auto k = std::make_pair(cell(u.x()), cell(u.y()));
         auto it = at.find(k);
         if (it != at.end()) {
@@ -100,8 +95,7 @@ PoreStats pores(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d&
     // one vertex): the crossings of one fiber with two fibers zipped on top of each other are round-off apart, and
     // their order along it says nothing. Contraction keeps the graph planar; dropping the piece cut the fiber.
     const double tol = 1e-9 * m.box.L;
-    std::vector<int> rep(nv);
-    std::iota(rep.begin(), rep.end(), 0);
+    UnionFind rep(nv);
     struct Piece {
         int from, to;
         Eigen::Vector2d d;  // along the segment (unwrapped)
@@ -113,7 +107,7 @@ PoreStats pores(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d&
         for (size_t k = 0; k + 1 < p.size(); ++k) {
             if (p[k].second == p[k + 1].second) continue;
             const Eigen::Vector2d d = (p[k + 1].first - p[k].first) * D[e];
-            if (d.norm() < tol) rep[find(rep, p[k].second)] = find(rep, p[k + 1].second);
+            if (d.norm() < tol) rep.unite(p[k].second, p[k + 1].second);
             else pieces.push_back({p[k].second, p[k + 1].second, d});
         }
     }
@@ -126,7 +120,7 @@ PoreStats pores(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d&
     };
     std::vector<Half> half;
     for (const Piece& p : pieces) {
-        const int f = find(rep, p.from), t = find(rep, p.to);
+        const int f = rep.find(p.from), t = rep.find(p.to);
         Eigen::Vector2i s(0, 0);
         if (m.box.periodic) {
             const Eigen::Vector2d w = Bi * (p.d - (pos[t] - pos[f]));
@@ -160,9 +154,8 @@ PoreStats pores(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d&
         return v[(r + v.size() - 1) % v.size()];
     };
     // Connected components, for the islands below.
-    std::vector<int> comp(nv);
-    std::iota(comp.begin(), comp.end(), 0);
-    for (size_t h = 0; h < half.size(); h += 2) comp[find(comp, half[h].from)] = find(comp, half[h].to);
+    UnionFind comp(nv);
+    for (size_t h = 0; h < half.size(); h += 2) comp.unite(half[h].from, half[h].to);
     struct Face {
         int h0, n;
         double area;
@@ -196,7 +189,7 @@ PoreStats pores(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d&
             // Clockwise: the outer boundary of a component that does not wind around the torus and encloses area.
             // Inside a pore it is an island, and the pore around it is not a disk (below). A tree (a fiber crossing
             // nothing) encloses none and is left where it lies: the pore keeps its area.
-            const int c = find(comp, half[h0].from);
+            const int c = comp.find(half[h0].from);
             if (!seen[c]) seen[c] = 1, island_point.push_back(half[h0].from);
             continue;
         }
@@ -212,11 +205,11 @@ PoreStats pores(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d&
     // the periodic images that fall in the pore's bounds); its area is not that pore's, and the pore, not a disk,
     // goes to the remainder.
     for (int v : island_point) {
-        const int c = find(comp, v);
+        const int c = comp.find(v);
         const Eigen::Vector2d u = Bi * pos[v];
         Face* best = nullptr;
         for (Face& f : faces) {
-            if (find(comp, half[f.h0].from) == c || (best && f.area >= best->area)) continue;
+            if (comp.find(half[f.h0].from) == c || (best && f.area >= best->area)) continue;
             bool in = !m.box.periodic && (u.array() >= f.lo.array()).all() && (u.array() <= f.hi.array()).all() &&
                       inside(f.poly, pos[v]);
             if (m.box.periodic)

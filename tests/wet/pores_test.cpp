@@ -38,14 +38,27 @@ TEST_CASE("pores: a periodic square grid has exactly its cells", "[wet][pores]")
     }
 }
 
+namespace {
+double cross2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+// Four fibers of length 1 crossing at the corners of the square [c - h, c + h]^2 (network units; h = 0.27 keeps the
+// corners off the fibers' nodes).
+std::vector<Line> square(double c, double h) {
+    return {{c, c - h, 0, 1, 0.5}, {c + h, c, 90, 1, 0.5}, {c, c + h, 180, 1, 0.5}, {c - h, c, 270, 1, 0.5}};
+}
+// Three fibers along the sides of the triangle P, each extended by `overhang` past its corners; its area in seed units.
+double add_triangle(std::vector<Line>& lines, const Eigen::Vector2d P[3], double overhang = 0.02) {
+    for (int i = 0; i < 3; ++i) {
+        const Eigen::Vector2d a = P[i], b = P[(i + 1) % 3], c = 0.5 * (a + b), d = b - a;
+        lines.push_back({c.x(), c.y(), std::atan2(d.y(), d.x()) * 180 / M_PI, d.norm() + 2 * overhang, 0.5});
+    }
+    return 100 * 0.5 * std::abs(cross2d(P[1] - P[0], P[2] - P[0]));
+}
+}  // namespace
+
 TEST_CASE("pores: a single triangle in a box", "[wet][pores]") {
     const Eigen::Vector2d P[3] = {{1.2, 1.2}, {1.9, 1.25}, {1.5, 1.8}};
     std::vector<Line> lines;
-    for (int i = 0; i < 3; ++i) {
-        const Eigen::Vector2d a = P[i], b = P[(i + 1) % 3], c = 0.5 * (a + b), d = b - a;
-        lines.push_back({c.x(), c.y(), std::atan2(d.y(), d.x()) * 180 / M_PI, d.norm() + 0.3, 0.5});
-    }
-    const double area = 100 * 0.5 * std::abs((P[1] - P[0]).x() * (P[2] - P[0]).y() - (P[1] - P[0]).y() * (P[2] - P[0]).x());
+    const double area = add_triangle(lines, P, 0.15);
     for (bool periodic : {true, false}) {
         const Model m = model_of(network_of(lines, 3.0, periodic), 10);
         const PoreStats p = pores(m, m.x, m.box.B0());
@@ -72,23 +85,6 @@ TEST_CASE("bundles: fibers joined by aligned bridges", "[wet][bundles]") {
     CHECK(s.bundle_of_fiber[2] != s.bundle_of_fiber[0]);
     CHECK(s.histogram.at(2) == 1);
 }
-
-namespace {
-double cross2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
-// Four fibers of length 1 crossing at the corners of the square [c - h, c + h]^2 (network units; h = 0.27 keeps the
-// corners off the fibers' nodes).
-std::vector<Line> square(double c, double h) {
-    return {{c, c - h, 0, 1, 0.5}, {c + h, c, 90, 1, 0.5}, {c, c + h, 180, 1, 0.5}, {c - h, c, 270, 1, 0.5}};
-}
-// Three fibers along the sides of the triangle P (extended by 0.02 past its corners); its area in seed units.
-double add_triangle(std::vector<Line>& lines, const Eigen::Vector2d P[3]) {
-    for (int i = 0; i < 3; ++i) {
-        const Eigen::Vector2d a = P[i], b = P[(i + 1) % 3], c = 0.5 * (a + b), d = b - a;
-        lines.push_back({c.x(), c.y(), std::atan2(d.y(), d.x()) * 180 / M_PI, d.norm() + 0.04, 0.5});
-    }
-    return 100 * 0.5 * std::abs(cross2d(P[1] - P[0], P[2] - P[0]));
-}
-}  // namespace
 
 TEST_CASE("pores: a face with an island inside is not a disk", "[wet][pores]") {
     // A triangle of three fibers inside a square of four, touching nothing: the triangle is a pore, the square's face
