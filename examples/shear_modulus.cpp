@@ -1,7 +1,8 @@
-// fibernet as a library: the linear shear modulus of a Mikado network at a shear strain gamma, what
+// fibernet as a library: the linear shear and bulk moduli of a Mikado network at a shear strain gamma, what
 // `fibernet modulus --L L --q Q --pl PL --seed S --gamma G` computes, in a few calls
 // (scene -> network -> model -> energy -> solver -> results). Build: examples/CMakeLists.txt.
 //   shear_modulus [L=5] [q=8] [pl=1] [seed=1] [gamma=0]
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -38,15 +39,22 @@ int main(int argc, char** argv) try {
         std::fprintf(stderr, "not converged: %s\n", eq.result.message.c_str());
         return 1;
     }
+    // The shear and bulk moduli from one factorization, as `fibernet modulus` computes them (the same modes and
+    // options, so the two programs give the same numbers). The state is an equilibrium to the tolerance Newton
+    // accepted (so.tol, or its round-off floor when that is larger).
     const Stress st = stress(energy, eq.q, F);
-    const auto moduli = linear_moduli(energy, eq.q, F, {shear_mode(F, st.area)}, {}, nullptr, newton.factorization());
-    const Modulus& G = moduli.front();
-    if (!G.ok) {
-        std::fprintf(stderr, "the linear solve failed\n");
-        return 1;
-    }
-    std::printf("fibers %zu  energy %.10g  G %.10g  G_affine %.10g  G/G_affine %.6g  (+- %.1e)\n", net.fibers.size(),
-                eq.energy, G.value, G.affine, G.value / G.affine, G.error);
+    ModuliOptions mo;
+    mo.equilibrium_tol = std::max({mo.equilibrium_tol, so.tol, eq.result.grad_max});
+    const auto moduli =
+        linear_moduli(energy, eq.q, F, {shear_mode(F, st.area), bulk_mode(F, st.area)}, mo, nullptr, newton.factorization());
+    for (const Modulus& M : moduli)
+        if (!M.ok) {
+            std::fprintf(stderr, "the linear solve for %s failed\n", M.name.c_str());
+            return 1;
+        }
+    const Modulus &G = moduli[0], &K = moduli[1];
+    std::printf("fibers %zu  energy %.10g  G %.17g  G_error %.3g  G_affine %.17g  G/G_affine %.6g  K %.17g  K_error %.3g\n",
+                net.fibers.size(), eq.energy, G.value, G.error, G.affine, G.value / G.affine, K.value, K.error);
     return 0;
 } catch (const std::exception& e) {
     std::fprintf(stderr, "shear_modulus: %s\n", e.what());

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs fibernet's build dependencies from Debian 12's packages (only what is missing), then builds.
-# Usage: scripts/setup.sh [--no-build]
+# Usage: scripts/setup.sh [--no-build | --all]
+#   default: build only the fibernet executable (the README's main job needs nothing else);
+#   --all: also the tests and benchmarks (scripts/test.sh); --no-build: install packages only.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 pkgs=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libopenblas-dev
@@ -16,6 +18,15 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
 fi
-[ "${1:-}" = "--no-build" ] && exit 0
+mode="${1:-}"
+case "$mode" in
+  ""|--all|--no-build) ;;
+  *) echo "setup: unknown option '$mode' (expected --no-build or --all)" >&2; exit 2 ;;
+esac
+[ "$mode" = "--no-build" ] && exit 0
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >&2
-cmake --build build -j"$(nproc)" >&2
+if [ "$mode" = "--all" ]; then
+  cmake --build build -j"$(nproc)" >&2
+else
+  cmake --build build -j"$(nproc)" --target fibernet >&2
+fi

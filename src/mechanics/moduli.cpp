@@ -132,6 +132,23 @@ Eigen::VectorXd affine_velocity(const NetworkEnergy& e, const Eigen::VectorXd& x
     return v;
 }
 
+namespace {
+// Names every modulus that failed, by cause (a saddle, or a CG that did not converge), e.g. "... for G, K".
+std::string failure_message(const std::vector<Modulus>& out, const std::vector<char>& broke) {
+    std::string saddle, unconverged;
+    for (size_t m = 0; m < out.size(); ++m) {
+        if (out[m].ok) continue;
+        std::string& list = broke[m] ? saddle : unconverged;
+        list += (list.empty() ? "" : ", ") + out[m].name;
+    }
+    std::string msg;
+    if (!saddle.empty()) msg = "H is not positive semidefinite at this state (a saddle): no modulus for " + saddle;
+    if (!unconverged.empty())
+        msg += (msg.empty() ? "" : "; ") + std::string("conjugate gradients for H^+ E_xt did not converge for ") + unconverged;
+    return msg;
+}
+}  // namespace
+
 std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const std::vector<StrainTerms>& terms,
                                     const std::vector<StrainMode>& modes, const ModuliOptions& opt, ModuliInfo* info,
                                     CholmodLLT* shared_llt) {
@@ -287,10 +304,8 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
             // Accepted when converged, or stopped by round-off with the tail below 1e-7 of the cancellation scale
             // (the seed scheme's 1e-4 segments at L = 20 end there; the error is reported).
             Mo.ok = std::isfinite(Mo.value) && !broke[m] && (conv[m] || tail <= 1e-7 * scale_ref[m]);
-            if (!Mo.ok)
-                inf.message = broke[m] ? "H is not positive semidefinite at this state (a saddle): no modulus for " + Mo.name
-                                       : "conjugate gradients for H^+ E_xt did not converge for " + Mo.name;
         }
+        inf.message = failure_message(out, broke);
         inf.seconds_solve += since(t0);
         for (const auto& m : out)
             if (!m.ok) return false;

@@ -165,6 +165,18 @@ TEST_CASE("a floppy network (q = 2, below percolation) has G = 0 and K = 0", "[m
     CHECK(lin.G >= -lin.G_err);
 }
 
+// A bound on the residual a model reduction leaves at the kept nodes of the full equilibrium q: each kept node keeps
+// its own residual and gains at most the summed residuals of the dropped nodes (each dropped part's energy is
+// translation invariant, so the force on its pins is minus the sum of its other nodes' residuals), plus the round-off
+// floor of evaluating the forces again.
+double removed_residual_bound(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F, int dropped_nodes) {
+    EnergyEval ev;
+    Eigen::SparseMatrix<double> H = e.hessian_pattern();
+    e.evaluate(q, F, Eigen::Matrix2d::Zero(), kGradient | kHessian, ev, &H);
+    const double gmax = ev.gradient.cwiseAbs().maxCoeff(), floor = roundoff_floor(H, q);
+    return (1 + dropped_nodes) * std::max(gmax, floor) + floor;
+}
+
 // Pruning keeps a node on a kept fiber where a dropped fiber was pinned (Fiber::breakpoints), so the kept fibers are
 // discretized exactly as before and the results agree to solver precision at any h. (Before breakpoints, seed 5
 // at h = 1 differed by 1.1e-4: the discretization error of splitting the kept fiber differently.)
@@ -195,9 +207,9 @@ TEST_CASE("pruning dangling fibers and non-spanning clusters changes neither G n
             const Eigen::VectorXd qp = ep.dofs(xp);
             EnergyEval evp;
             ep.evaluate(qp, F, Eigen::Matrix2d::Zero(), kGradient, evp);
-            // Measured 1.5e-7 / 3.7e-7 at 1% shear (seed 5): the full solve's own convergence floor plus the pinned
-            // dangling fibers' residual forces; forces in the network are O(1e-2..1).
-            CHECK(evp.gradient.cwiseAbs().maxCoeff() <= 1e-6);
+            // What the full solve leaves: a dropped part pulls on its pins with minus the sum of its other nodes'
+            // residuals (its energy is translation invariant), so no kept node is off by more than that.
+            CHECK(evp.gradient.cwiseAbs().maxCoeff() <= removed_residual_bound(ef, a.q, F, full.num_nodes() - pruned.num_nodes()));
             const Linear la = moduli_at(ef, a.q, F), lb = moduli_at(ep, qp, F);
             REQUIRE(la.ok);
             REQUIRE(lb.ok);
@@ -230,7 +242,10 @@ TEST_CASE("trimming end arms changes neither the equilibrium nor G and K", "[mod
         REQUIRE(trimmed.num_nodes() < full.num_nodes());
         NetworkEnergy ef(full), et(trimmed);
         NewtonSolver newton(options());
-        for (double gamma : {0.0, 0.01}) {
+        // Sheared, the seed scheme's equilibrium is known only to its round-off floor (1e-4 arm segments: max|g| ~1e-7),
+        // and the G of two such states differ by 1.2e-6 relative on one CPU, 2x that on another: beyond the errors
+        // the moduli report (which do not count the state's). At rest the state is exact on every CPU.
+        for (double gamma : scheme == Scheme::Seed ? std::vector<double>{0.0} : std::vector<double>{0.0, 0.01}) {
             const Eigen::Matrix2d F = deformation(StrainKind::Shear, gamma);
             const Equilibrium a = relax(ef, F, newton);
             REQUIRE(a.converged());
@@ -241,10 +256,8 @@ TEST_CASE("trimming end arms changes neither the equilibrium nor G and K", "[mod
             EnergyEval evt;
             et.evaluate(qt, F, Eigen::Matrix2d::Zero(), kGradient, evt);
             INFO("seed " << seed << " scheme " << to_string(scheme) << " gamma " << gamma);
-            // Measured 1.6e-7 (seed scheme, seed 5, 1% shear; 2e-12 on the even scheme): the removed hinges at the
-            // trimmed pins carried forces of that size that the full solve balanced against round-off-level forces
-            // in the arms' 1e-4 segments. Same bound as the pruning test above.
-            CHECK(evt.gradient.cwiseAbs().maxCoeff() <= 1e-6);
+            // The removed arms pull on their pins with what the full solve left in them (as in the pruning test).
+            CHECK(evt.gradient.cwiseAbs().maxCoeff() <= removed_residual_bound(ef, a.q, F, full.num_nodes() - trimmed.num_nodes()));
             CHECK(evt.energy == Approx(a.energy).epsilon(1e-9).margin(1e-13));
             CHECK(stress(et, qt, F).sigma(0, 1) == Approx(stress(ef, a.q, F).sigma(0, 1)).epsilon(1e-9).margin(1e-13));
             const Linear la = moduli_at(ef, a.q, F), lb = moduli_at(et, qt, F);
@@ -253,9 +266,9 @@ TEST_CASE("trimming end arms changes neither the equilibrium nor G and K", "[mod
             REQUIRE(la.G > 1e-6 * la.G_aff);
             INFO("G " << la.G << " vs " << lb.G << " (bounds " << la.G_err << ", " << lb.G_err << "), K " << la.K << " vs "
                       << lb.K << ", full max|g| " << a.result.grad_max);
-            // Measured 1.2e-6 relative in G for that seed-scheme state, 1e-9 on the even scheme.
-            CHECK(std::abs(lb.G - la.G) <= 2e-6 * std::abs(la.G) + la.G_err + lb.G_err);
-            CHECK(std::abs(lb.K - la.K) <= 2e-6 * std::abs(la.K) + la.K_err + lb.K_err);
+            // Measured 1e-9 relative on the even scheme at 1% shear.
+            CHECK(std::abs(lb.G - la.G) <= 1e-6 * std::abs(la.G) + la.G_err + lb.G_err);
+            CHECK(std::abs(lb.K - la.K) <= 1e-6 * std::abs(la.K) + la.K_err + lb.K_err);
             // Solved on its own, the trimmed model converges too.
             const Equilibrium b = relax(et, F, newton);
             REQUIRE(b.converged());
@@ -286,8 +299,10 @@ TEST_CASE("an empty network and one without crosslinks have G = 0, no crash", "[
         const Linear lin = moduli_at(e, eq.q, deformation(StrainKind::Shear, 0.01));
         CHECK(lin.ok);
         CHECK(lin.G_aff > 1);
-        // Free fibers: H has a 3-per-fiber null space (216 here) and CG stops on round-off near 1e-9 G_aff.
-        CHECK(std::abs(lin.G) <= 1e-8 * lin.G_aff);
+        // Free fibers: H has a 3-per-fiber null space (216 here) and CG stops on round-off near 1e-9 G_aff (rigid
+        // networks here have G >= 1e-4 G_aff, so 1e-7 still tells a floppy network from a rigid one).
+        CHECK(std::abs(lin.G) <= std::max(1e-7 * lin.G_aff, 2 * lin.G_err));
+        CHECK(lin.G >= -std::max(1e-7 * lin.G_aff, lin.G_err));
     }
 }
 

@@ -22,7 +22,13 @@ TEST_CASE("cholmod_llt: solves H + shift I, one or several right-hand sides", "[
     REQUIRE(llt.factorize(U, 0.25));
     const Eigen::MatrixXd X = llt.solve_many(B);
     CHECK(((H + 0.25 * Eigen::MatrixXd::Identity(n, n)) * X - B).norm() < 1e-12 * B.norm());
-    for (int c = 0; c < 3; ++c) CHECK((llt.solve(B.col(c)) - X.col(c)).norm() < 1e-14 * X.col(c).norm());
+    // One column and three are different BLAS kernels (dtrsv against dtrsm): each is backward stable, and on this
+    // well-conditioned matrix (kappa ~ 10) they agree to ~kappa eps, not bit for bit.
+    for (int c = 0; c < 3; ++c) {
+        const Eigen::VectorXd x = llt.solve(B.col(c));
+        CHECK(((H + 0.25 * Eigen::MatrixXd::Identity(n, n)) * x - B.col(c)).norm() < 1e-12 * B.col(c).norm());
+        CHECK((x - X.col(c)).norm() < 1e-12 * X.col(c).norm());
+    }
 }
 
 TEST_CASE("cholmod_llt: an indefinite matrix does not factor", "[cholmod_llt]") {

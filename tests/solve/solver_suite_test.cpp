@@ -145,14 +145,15 @@ TEST_CASE("a gradient with a force along a zero mode: solvers fail visibly", "[s
         INFO(name << ": " << to_string(r.status) << " (" << r.message << ") after " << r.iterations);
         CHECK(r.status != SolveStatus::Converged);
         check_honest(f, x, r, opt.tol);
-        // lbfgs-hessian and cg find that no step lowers the energy along their direction, or that neither the
-        // energy nor max|g| improves any more; NLopt's codes say FAILURE; FIRE and Ipopt only run out of budget
-        // (FIRE never looks at the energy). Plain lbfgs runs out of budget too: the Rosenbrock part keeps
-        // decreasing in relative terms near 0 while its approximate-Wolfe steps drift along the fake force.
-        if (name == "lbfgs-hessian" || name == "cg")
-            CHECK((r.status == SolveStatus::LineSearchFailed || r.status == SolveStatus::Stalled));
+        // cg finds that no step lowers the energy along its direction, or that neither the energy nor max|g|
+        // improves any more; NLopt's codes say FAILURE; FIRE only runs out of budget (it never looks at the
+        // energy). Plain lbfgs runs out of budget too: the Rosenbrock part keeps decreasing in relative terms near 0
+        // while its approximate-Wolfe steps drift along the fake force. These use no BLAS, so their way of failing
+        // is the same on every CPU. lbfgs-hessian (CHOLMOD) and Ipopt (MUMPS) factor with BLAS kernels that round
+        // differently on other CPUs: for them only the failure itself (checked above) is guaranteed.
+        if (name == "cg") CHECK((r.status == SolveStatus::LineSearchFailed || r.status == SolveStatus::Stalled));
         if (name == "lbfgs") CHECK(r.status == SolveStatus::IterationLimit);
         if (name.rfind("nlopt-", 0) == 0) CHECK((r.status == SolveStatus::Failed || r.status == SolveStatus::Stalled));
-        if (name == "fire" || name == "ipopt") CHECK(r.status == SolveStatus::IterationLimit);
+        if (name == "fire") CHECK(r.status == SolveStatus::IterationLimit);
     }
 }

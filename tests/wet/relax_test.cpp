@@ -48,6 +48,7 @@ TEST_CASE("wet relaxation: the active-set loop terminates and reports", "[wet][r
             NetworkEnergy e(m);
             Eigen::VectorXd q = e.dofs(m.x);
             auto s = newton();
+            s->options().max_iter = 1000;  // headroom over the few hundred it needs: the budget is not what is tested
             WetParams p;
             p.beta = beta;
             const auto initial = wet_crossings(net, m, m.x, m.box.B0(), {});
