@@ -69,13 +69,13 @@ std::string flag_of(const std::string& key) {
     return it == flags.end() ? "" : " (" + it->second + ")";
 }
 
-std::string shown(const nlohmann::json& v) { return v.is_null() ? "(none)" : v.is_string() ? v.get<std::string>() : v.dump(); }
+std::string shown(const nlohmann::json& v) { return v.is_null() ? "(none)" : v.is_string() ? v.get<std::string>() : json_text(v); }
 
 // completed: the sweep reached gamma_max (a run without --resume may then start over; --resume adds nothing).
 void write_checkpoint(const std::string& path, const nlohmann::json& params, int rows, const SweepState& s,
                       bool completed = false) {
     std::ostringstream os;
-    os << std::setprecision(17) << "fibernet-sweep-checkpoint 2\nparameters " << params.dump() << "\ncompleted "
+    os << std::setprecision(17) << "fibernet-sweep-checkpoint 2\nparameters " << json_text(params) << "\ncompleted "
        << (completed ? 1 : 0) << "\ndofs "
        << s.q.size() << "\nrows " << rows << "\nstep " << s.step << "\nt " << s.t << "\nnext_step " << s.next_step
        << "\nq\n";
@@ -98,8 +98,28 @@ bool completed_checkpoint(const std::string& path) {
            (is >> key >> done) && key == "completed" && done == 1;
 }
 
+// Refuses a checkpoint state that no sweep with these parameters writes (run_sweep): one row per step from step 0
+// at t = 0, t between 0 and gamma_max, and a next step in (0, max_step], at least min_step before the end.
+template <class Fail>
+void check_sweep_state(const Checkpoint& c, const SweepParams& p, const Fail& fail) {
+    const SweepState& s = c.state;
+    if (c.rows < 1) fail("rows = " + std::to_string(c.rows) + " must be >= 1 (the first row is written with the checkpoint)");
+    if (s.step != c.rows - 1)
+        fail("step = " + std::to_string(s.step) + " must be rows - 1 = " + std::to_string(c.rows - 1) +
+             " (steps are numbered from 0, one row each)");
+    const double dir = p.t_max > 0 ? 1 : -1, done = dir * s.t;
+    if (!std::isfinite(s.t) || done < 0 || done > std::abs(p.t_max) || (s.step == 0) != (s.t == 0))
+        fail("t = " + show(s.t) + " is not a strain this sweep reaches after step " + std::to_string(s.step) +
+             " (0 at step 0, else between 0 and gamma_max = " + show(p.t_max) + ")");
+    const bool at_end = dir * (p.t_max - s.t) <= 1e-14;
+    if (c.completed && !at_end) fail("completed = 1 contradicts t = " + show(s.t) + " short of gamma_max = " + show(p.t_max));
+    if (!(s.next_step > 0 && s.next_step <= p.max_step && (at_end || s.next_step >= p.min_step)))
+        fail("next_step = " + show(s.next_step) + " must be in [min_step, max_step] = [" + show(p.min_step) + ", " +
+             show(p.max_step) + "]");
+}
+
 // Reads a checkpoint and refuses it unless it was written with this run's parameters (each difference is named).
-Checkpoint read_checkpoint(const std::string& path, const nlohmann::json& params) {
+Checkpoint read_checkpoint(const std::string& path, const nlohmann::json& params, const SweepParams& p) {
     std::ifstream is(path);
     if (!is) throw InputError("--resume: checkpoint '" + path + "' cannot be opened");
     auto fail = [&](const std::string& m) -> void { throw InputError(path + ": " + m); };
@@ -117,7 +137,7 @@ Checkpoint read_checkpoint(const std::string& path, const nlohmann::json& params
     if (!recorded.is_object()) fail("parameters are not a JSON object");
     for (auto it = params.begin(); it != params.end(); ++it) {
         const nlohmann::json was = recorded.contains(it.key()) ? recorded[it.key()] : nlohmann::json();
-        if (was != it.value())
+        if (json_text(was) != json_text(it.value()))  // as written: non-UTF-8 bytes replaced
             fail(it.key() + " = " + shown(was) + " differs from this run's " + shown(it.value()) + flag_of(it.key()));
     }
     for (auto it = recorded.begin(); it != recorded.end(); ++it)  // e.g. a network file against a generated network
@@ -140,17 +160,34 @@ Checkpoint read_checkpoint(const std::string& path, const nlohmann::json& params
     s.q.resize(c.dofs);
     for (int i = 0; i < c.dofs; ++i)
         if (!(is >> s.q[i]) || !std::isfinite(s.q[i])) fail("q[" + std::to_string(i) + "] is missing or not finite");
+    if (is >> key) fail("unexpected '" + key + "' after the " + std::to_string(c.dofs) + " values of q");
+    check_sweep_state(c, p, fail);
     return c;
 }
 
-// Keeps the header and the first `rows` data rows (a row written after the last checkpoint is dropped).
-void truncate_csv(const std::string& path, int rows) {
+// Keeps the header and the first `rows` data rows (a row written after the last checkpoint is dropped), once they
+// are what this sweep wrote: its header, steps 0, 1, ... in order, and the last one at the checkpoint's strain t.
+void truncate_csv(const std::string& path, int rows, double t) {
     std::ifstream is(path);
     if (!is) throw InputError("--resume: output '" + path + "' cannot be opened");
+    auto fail = [&](const std::string& m) { throw InputError("--resume: '" + path + "': " + m); };
     std::string line, kept;
-    int n = -1;
-    while (n < rows && std::getline(is, line)) kept += line + "\n", ++n;
-    if (n < rows) throw InputError("--resume: '" + path + "' has fewer rows than its checkpoint says");
+    if (!std::getline(is, line) || line != kHeader) fail("line 1 is not the sweep's CSV header");
+    kept = line + "\n";
+    for (int n = 0; n < rows; ++n) {
+        if (!std::getline(is, line))
+            fail("has " + std::to_string(n) + " rows, fewer than the checkpoint's " + std::to_string(rows));
+        std::istringstream fields(line);
+        std::string step, gamma;
+        std::getline(fields, step, ','), std::getline(fields, gamma, ',');
+        if (step != std::to_string(n))
+            fail("row " + std::to_string(n + 1) + " is step '" + step + "', expected " + std::to_string(n));
+        char* end = nullptr;
+        const double g = std::strtod(gamma.c_str(), &end);
+        if (n + 1 == rows && (gamma.empty() || *end || g != t))  // 17 digits: the value round-trips exactly
+            fail("row " + std::to_string(rows) + " has gamma '" + gamma + "', the checkpoint's t = " + show(t));
+        kept += line + "\n";
+    }
     write_file_atomic(path, kept);
 }
 }  // namespace
@@ -193,7 +230,7 @@ void register_sweep(CLI::App& app) {
                              "parameters, or remove it");
         const nlohmann::json params = sweep_parameters(s, *p);
         Checkpoint c;
-        if (*resume) c = read_checkpoint(*ckpt, params);  // before any work: a mismatch costs nothing
+        if (*resume) c = read_checkpoint(*ckpt, params, *p);  // before any work: a mismatch costs nothing
         SolverOptions so;
         so.tol = s.solver.tol, so.max_iter = s.solver.max_iter;
         auto solver = make_solver(s.solver.name, so);
@@ -211,7 +248,7 @@ void register_sweep(CLI::App& app) {
                 throw InputError(*ckpt + ": dofs = " + std::to_string(c.dofs) + " differs from this model's " +
                                  std::to_string(e.num_dofs()));
             rows = c.rows;
-            truncate_csv(*out, rows);
+            truncate_csv(*out, rows, start.t);
             if (!*quiet)
                 std::cerr << (c.completed ? "sweep: the checkpoint's sweep is complete; nothing to add\n"
                                           : "sweep: resuming at step " + std::to_string(start.step) + ", gamma = " +
@@ -227,6 +264,7 @@ void register_sweep(CLI::App& app) {
         SweepState last = start;
         cb.on_step = [&](const SweepRow& r, const SweepState& st) {
             csv << csv_row(r) << '\n' << std::flush;
+            if (!csv) throw OutputError("cannot append step " + std::to_string(r.step) + " to '" + *out + "'");
             write_checkpoint(*ckpt, params, ++rows, st);
             last = st;
             if (!*quiet)

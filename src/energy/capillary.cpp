@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include "fibernet/util/error.hpp"
+#include "fibernet/util/utf8.hpp"
 
 namespace fibernet {
 
@@ -56,6 +58,13 @@ CapillaryLaw CapillaryLaw::read(const std::string& path) {
     int ln = 0;
     while (std::getline(is, line)) {
         ++ln;
+        // The table's text goes into the wet summary (JSON): it must be UTF-8, comments included.
+        if (const std::size_t at = invalid_utf8_at(line); at != std::string::npos) {
+            char byte[8];
+            std::snprintf(byte, sizeof byte, "0x%02x", static_cast<unsigned char>(line[at]));
+            throw InputError(path + ":" + std::to_string(ln) + ": byte " + byte + " at column " + std::to_string(at + 1) +
+                             " is not UTF-8 (save the law file as UTF-8 text)");
+        }
         // '#' starts a comment, also after a row's two numbers ("90 0 # end").
         const std::string data = line.substr(0, line.find('#'));
         if (data.find_first_not_of(" \t\r") == std::string::npos) continue;

@@ -1,5 +1,6 @@
 #include "fibernet/scene/scene.hpp"
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -231,7 +232,14 @@ Scene load_scene(const std::string& path) {
     if (!is) throw InputError("scene file '" + path + "' cannot be opened");
     std::stringstream ss;
     ss << is.rdbuf();
-    Scene s = parse_scene(ss.str(), path);
+    // Another of fibernet's files given where a scene is expected: say what it is and where it goes.
+    const std::string text = ss.str();
+    for (const auto& [magic, what] : std::vector<std::array<std::string, 2>>{
+             {"fibernet-network", "a network file, not a scene (TOML): give it as --network " + path},
+             {"fibernet-model", "a model file (what export and relax write), not a scene (TOML)"},
+             {"fibernet-sweep-checkpoint", "a sweep checkpoint, not a scene (TOML): continue its sweep with sweep --resume"}})
+        if (text.rfind(magic, 0) == 0) throw InputError("'" + path + "' is " + what);
+    Scene s = parse_scene(text, path);
     // A network file named in a scene is found next to the scene, wherever it is run from.
     if (!s.network_file.empty() && std::filesystem::path(s.network_file).is_relative())
         s.network_file = (std::filesystem::path(path).parent_path() / s.network_file).string();  // ".." as the OS resolves it

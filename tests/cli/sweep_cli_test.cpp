@@ -123,3 +123,62 @@ TEST_CASE("cli sweep: --help does not offer --gamma, which sweep refuses", "[cli
     CHECK(slurp(tmpdir() + "/stderr").find("sweep takes --gamma-max, not --gamma") != std::string::npos);
     CHECK(!exists(tmpdir() + "/sweep_gamma.csv"));
 }
+
+TEST_CASE("cli sweep: --resume refuses checkpoint fields and CSV rows no sweep writes, naming them", "[cli][sweep][input]") {
+    const std::string csv = tmpdir() + "/sweep_fields.csv";
+    const std::string net = "sweep --L 3 --q 7 --seed 4 --scheme even --h 2.5 --gamma-max 0.02 --step 0.01 -q -o ";
+    REQUIRE(run(net + csv) == 0);
+    const std::string rows = slurp(csv);
+    std::string ckpt = slurp(csv + ".ckpt");  // as if interrupted after its last step: --resume adds nothing
+    REQUIRE(ckpt.find("\ncompleted 1\n") != std::string::npos);
+    ckpt.replace(ckpt.find("\ncompleted 1\n"), 13, "\ncompleted 0\n");
+    REQUIRE(ckpt.find("\nrows 3\nstep 2\nt 0.02\n") != std::string::npos);
+    // Replace the line that starts with `key ` (its first occurrence after the parameters) by `key value`.
+    auto with = [&](const std::string& key, const std::string& value) {
+        std::string ck = ckpt;
+        const auto at = ck.find("\n" + key + " ", ck.find("\ncompleted"));
+        ck.replace(at + 1, ck.find('\n', at + 1) - at - 1, key + " " + value);
+        return ck;
+    };
+    struct Case {
+        std::string checkpoint, message;
+    };
+    const Case cases[] = {
+        {with("next_step", "0"), "next_step = 0 must be in [min_step, max_step]"},
+        {with("next_step", "-0.001"), "next_step = -0.001 must be in"},
+        {with("next_step", "0.5"), "next_step = 0.5 must be in"},
+        {with("rows", "-1"), "rows = -1 must be >= 1"},
+        {with("rows", "0"), "rows = 0 must be >= 1"},
+        {with("step", "-5"), "step = -5 must be rows - 1 = 2"},
+        {with("rows", "2"), "step = 2 must be rows - 1 = 1"},
+        {with("t", "-617"), "t = -617 is not a strain this sweep reaches"},
+        {with("t", "0.03"), "t = 0.029999999999999999 is not a strain"},
+        {with("t", "0.01"), "row 3 has gamma '0.02', the checkpoint's t = 0.01"},
+        {with("t", "0.01").replace(ckpt.find("\ncompleted 0\n"), 13, "\ncompleted 1\n"),
+         "completed = 1 contradicts t = 0.01"},
+        {ckpt + "7\n", "unexpected '7' after the"},
+    };
+    for (const auto& c : cases) {
+        INFO(c.message);
+        write(csv + ".ckpt", c.checkpoint);
+        CHECK(run(net + csv + " --resume") == 2);
+        CHECK(slurp(tmpdir() + "/stderr").find(c.message) != std::string::npos);
+        CHECK(slurp(csv) == rows);  // untouched
+    }
+    // The CSV must be this sweep's: its header, steps 0, 1, ... in order.
+    write(csv + ".ckpt", ckpt);
+    std::string bad = rows;
+    bad.replace(0, 4, "STEP");
+    write(csv, bad);
+    CHECK(run(net + csv + " --resume") == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("line 1 is not the sweep's CSV header") != std::string::npos);
+    bad = rows;
+    bad.replace(bad.find("\n1,"), 3, "\n7,");
+    write(csv, bad);
+    CHECK(run(net + csv + " --resume") == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("row 2 is step '7', expected 1") != std::string::npos);
+    CHECK(slurp(csv) == bad);
+    write(csv, rows);
+    CHECK(run(net + csv + " --resume") == 0);  // the checkpoint as written resumes
+    CHECK(slurp(csv) == rows);
+}

@@ -72,3 +72,18 @@ TEST_CASE("scene: a network file is found next to its scene and must exist", "[s
     CHECK_THROWS_WITH(load_scene(dir + "/missing.toml"),
                       Catch::Contains("missing.toml: [network].file = '" + dir + "/gone.txt' is not a readable file"));
 }
+
+TEST_CASE("scene: another of fibernet's files given as the scene is named for what it is", "[scene][input]") {
+    // `fibernet rigidity net.txt` answered with toml++'s "expected '=', saw '1'".
+    const std::string dir = "/tmp/fibernet_scene_test_dir";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "/n.net") << "fibernet-network 1\nbox 10 open\nfibers 1\n0 0 0 1\ncrossings 0\n";
+    std::ofstream(dir + "/m.txt") << "fibernet-model 1\nbox 100 open\n";
+    std::ofstream(dir + "/s.ckpt") << "fibernet-sweep-checkpoint 2\nparameters {}\n";
+    CHECK_THROWS_WITH(load_scene(dir + "/n.net"),
+                      Catch::Contains("n.net' is a network file, not a scene (TOML): give it as --network " + dir + "/n.net"));
+    CHECK_THROWS_WITH(load_scene(dir + "/m.txt"), Catch::Contains("m.txt' is a model file"));
+    CHECK_THROWS_WITH(load_scene(dir + "/s.ckpt"), Catch::Contains("s.ckpt' is a sweep checkpoint"));
+    std::ofstream(dir + "/t.toml") << "# fibernet-network 1 in a comment is still a scene\n[network]\nL = 4\n";
+    CHECK(load_scene(dir + "/t.toml").mikado.L == 4);
+}

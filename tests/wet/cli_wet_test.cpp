@@ -137,6 +137,8 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
     const std::string law = tmpdir() + "/law.txt", unsorted = tmpdir() + "/unsorted.txt", scene = tmpdir() + "/wet.toml";
     write(law, "0 -1\n45 -0.5\n100 0\n");
     write(unsorted, "0 -1\n60 -0.2\n30 -0.7\n90 0\n");
+    const std::string latin1 = tmpdir() + "/latin1.txt";  // its text goes into summary.json: exit 3 before
+    write(latin1, "# r\xe9sultats Surface Evolver\n0 -1\n90 0\n");
     write(scene, "[network]\nL = 2.5\nq = 5\n[wet]\nfraction = 1.5\n");
     struct Case {
         std::string args, needle;
@@ -147,6 +149,7 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
                           Case{"--bundle-partners -1", "bundle_partners = -1"},
                           Case{"--crossings some", "some"}, Case{"--law " + law, "100"},
                           Case{"--law " + unsorted, "30"}, Case{scene, "fraction = 1.5"},
+                          Case{"--law " + latin1, "latin1.txt:1: byte 0xe9 at column 4 is not UTF-8"},
                           Case{"--prune ends", "prune \"ends\" is not valid for `fibernet wet`"},
                           Case{"--free-box --open", "periodic"}, Case{"--free-box --free-box-shape round", "round"},
                           Case{"--free-box --free-box-tol 0", "free_box_tol = 0"},
