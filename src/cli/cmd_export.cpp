@@ -22,7 +22,7 @@ void register_export(CLI::App& app) {
         write_model(os, m);
         if (out->empty()) std::cout << os.str();
         else write_file_atomic(*out, os.str());
-        std::cerr << to_json(summarize(m)).dump() << "\n";
+        std::cerr << json_text(to_json(summarize(m))) << "\n";
     });
 }
 

@@ -22,7 +22,7 @@ void register_generate(CLI::App& app) {
         else save_network(net, *out);
         nlohmann::json j = to_json(statistics(net));
         j["generation_seconds"] = t;
-        std::cerr << j.dump() << "\n";
+        std::cerr << json_text(j) << "\n";
     });
 }
 

@@ -226,6 +226,10 @@ void register_percolation(CLI::App& app) {
                     const PercolationSample s = percolation_sample(o->pl, todo[i].L, todo[i].q, todo[i].sample, o->seed);
                     std::lock_guard<std::mutex> lock(mu);
                     csv << csv_line(s) << std::flush;
+                    if (!csv) {  // a full device: stop taking samples; reported after the pool
+                        next = todo.size();
+                        return;
+                    }
                     rows.push_back(s);
                     ++finished;
                     const double t = seconds_since(t0);
@@ -239,7 +243,8 @@ void register_percolation(CLI::App& app) {
             std::vector<std::thread> pool;
             for (int t = 0; t < o->threads; ++t) pool.emplace_back(worker);
             for (auto& t : pool) t.join();
-            if (!csv) throw std::runtime_error("writing " + o->out + " failed");
+            if (!csv) throw OutputError("cannot append samples to --out '" + o->out + "' (" + std::to_string(finished) +
+                                        " written; --resume continues)");
         }
         // P(q) per L from every row in the CSV (earlier runs with other q ranges included).
         std::map<double, std::map<double, std::array<int, 3>>> counts;  // L -> q -> {n, rigid, connected}

@@ -415,7 +415,7 @@ void register_wet(CLI::App& app) {
             }
             nlohmann::json r = summary(false);
             r["interrupted"] = true;
-            g_report = r.dump(2) + "\n";
+            g_report = json_text(r, 2) + "\n";
             std::ostringstream m;
             m << "wet: interrupted during beta = " << betas[k] << " (" << k + 1 << " of " << betas.size() << "); "
               << (k == 0 ? std::string("no beta finished")

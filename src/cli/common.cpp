@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <charconv>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -187,10 +188,23 @@ std::string file_bytes(const std::string& path, const std::string& what) {
     return os.str();
 }
 
+std::string json_text(const nlohmann::json& j, int indent) {
+    // Strings that are not UTF-8 (a Latin-1 file name) are written with U+FFFD in their place, not refused.
+    return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 void emit_json(const nlohmann::json& j, const std::string& path) {
-    const std::string text = j.dump(2) + "\n";
-    if (path.empty()) std::cout << text << std::flush;
+    const std::string text = json_text(j, 2) + "\n";
+    if (path.empty()) std::cout << text, flush_stdout();
     else write_file_atomic(path, text);
+}
+
+void flush_stdout() {
+    errno = 0;
+    std::cout.flush();
+    if (!std::cout || std::fflush(stdout) != 0)
+        throw OutputError(std::string("cannot write the results to standard output (") +
+                          (errno ? std::strerror(errno) : "the write failed") + ")");
 }
 
 int& exit_code() {

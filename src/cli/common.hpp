@@ -69,8 +69,12 @@ nlohmann::json prune_rules(const Scene& s);  // the pruning rules applied, e.g. 
 nlohmann::json scene_parameters(const Scene& s);
 nlohmann::json to_json(const ModelSummary& s);
 
+// JSON text (indent -1: one line); bytes that are not UTF-8 become U+FFFD instead of an exception.
+std::string json_text(const nlohmann::json& j, int indent = -1);
 // Prints JSON to stdout (or to `path` atomically when non-empty).
 void emit_json(const nlohmann::json& j, const std::string& path = "");
+// Flushes standard output; OutputError (exit 4) when it cannot be written.
+void flush_stdout();
 // The bytes of a file a result depends on (a network file, a law table), e.g. for its fingerprint (util/hash.hpp);
 // InputError naming `what` and the path if it cannot be read.
 std::string file_bytes(const std::string& path, const std::string& what);

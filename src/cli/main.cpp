@@ -1,6 +1,6 @@
 // fibernet: command-line entry. Each subcommand lives in its own cmd_<name>.cpp and registers itself here.
 // Exit codes: 0 success, 1 a computation that did not succeed (e.g. a solver that did not converge),
-// 2 bad input (flags, values, files), 3 an internal error.
+// 2 bad input (flags, values, files), 3 an internal error, 4 a result that could not be written (names the file).
 #include <CLI/CLI.hpp>
 #include <iostream>
 
@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
             if (!known) throw InputError(std::string("unknown command '") + argv[1] + "' (expected one of: " + names + ")");
         }
         app.parse(argc, argv);
+        cli::flush_stdout();  // results on stdout count only once they are out (a full device fails here)
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::CallForAllHelp& e) {
@@ -48,6 +49,9 @@ int main(int argc, char** argv) {
     } catch (const InputError& e) {
         std::cerr << "fibernet: error: " << e.what() << "\n";
         return 2;
+    } catch (const OutputError& e) {
+        std::cerr << "fibernet: error: " << e.what() << "\n";
+        return 4;
     } catch (const std::exception& e) {
         std::cerr << "fibernet: internal error: " << e.what() << "\n";
         return 3;

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -218,26 +220,35 @@ Network read_network(std::istream& is, const std::string& source) {
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {
+    // Written, flushed and closed before it counts: a full device fails at the flush, not at operator<<.
+    auto write_all = [&](const std::string& target) -> bool {
+        std::ofstream os(target, std::ios::binary);
+        if (!os) return false;
+        os.write(content.data(), static_cast<std::streamsize>(content.size()));
+        os.close();
+        return !os.fail();
+    };
+    auto failed = [&](const std::string& what) {
+        return OutputError("cannot " + what + " output '" + path + "' (" + (errno ? std::strerror(errno) : "the write failed") + ")");
+    };
     struct stat st;
     if (stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
         // A device or pipe (/dev/null, /dev/stdout): write straight to it; renaming over it would replace it.
-        std::ofstream os(path, std::ios::binary);
-        if (!(os << content)) throw InputError("cannot write output '" + path + "'");
+        errno = 0;
+        if (!write_all(path)) throw failed("write");
         return;
     }
     const std::string tmp = path + ".tmp";
-    {
-        std::ofstream os(tmp, std::ios::binary);
-        if (!os) throw InputError("cannot open output file '" + path + "' for writing");
-        os << content;
-        if (!os) {
-            std::remove(tmp.c_str());
-            throw std::runtime_error("failed writing '" + path + "'");
-        }
+    errno = 0;
+    if (!write_all(tmp)) {
+        const OutputError e = failed("write");
+        std::remove(tmp.c_str());
+        throw e;
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        const OutputError e = failed("rename '" + tmp + "' to the");
         std::remove(tmp.c_str());
-        throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "'");
+        throw e;
     }
 }
 

@@ -76,3 +76,18 @@ TEST_CASE("cli: bad input exits 2, names the value and writes no output file", "
     CHECK(slurp(tmpdir() + "/stderr").find("bad.toml: pl (crosslink probability) = -0.1") != std::string::npos);
     CHECK(!exists(out));
 }
+
+TEST_CASE("cli: a result that cannot be written exits 4 naming where it went", "[cli][output]") {
+    // A full device: the JSON was lost and the exit code was 0.
+    const std::string exe = FIBERNET_EXE, err = tmpdir() + "/full_stderr";
+    auto rc_of = [&](const std::string& args) {
+        const int rc = std::system((exe + " " + args + " 2>" + err).c_str());
+        return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+    };
+    CHECK(rc_of("modulus --L 3 --q 8 --scheme even -q >/dev/full") == 4);
+    CHECK(slurp(err).find("cannot write the results to standard output") != std::string::npos);
+    CHECK(rc_of("generate --L 3 --q 4 >/dev/full") == 4);
+    CHECK(rc_of("generate --L 3 --q 4 -o /dev/full") == 4);
+    CHECK(slurp(err).find("cannot write output '/dev/full' (No space left on device)") != std::string::npos);
+    CHECK(rc_of("modulus --L 3 --q 8 --scheme even -q >/dev/null") == 0);  // a device that takes the bytes is fine
+}

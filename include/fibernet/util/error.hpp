@@ -13,6 +13,13 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+// A result that could not be written (a full device, a lost directory): the CLI maps it to exit code 4. The
+// message names the file.
+class OutputError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
 // Formats a value for an error message with full precision.
 template <class T>
 std::string show(const T& v) {
