@@ -504,6 +504,17 @@ FreeBoxResult free_box(const NetworkEnergy& dry, const Eigen::Matrix2d& F0, cons
     R.F0 = R.F = F0;
     BoxSearch S(dry, F0, params, solver, active_set, opt, R);
     R.stress_scale = S.sc();
+    if (R.stress_scale == 0) {
+        // No fiber length (an empty network): no stress at any box, so the given box is the free one, exactly.
+        // (The search would divide by the zero stress scale and walk the box out to twice its side.)
+        R.converged = true;
+        R.message = "no fibers: the network carries no stress at any box, so the free box is the given one";
+        R.q = q0, R.bridges = bridges0;
+        R.stress0 = R.stress = wet_stress(dry, q0, F0, bridges0, params);
+        R.energy = WetEnergy(dry, F0, R.bridges, params).split(R.q);
+        R.seconds = S.elapsed();
+        return R;
+    }
     BoxState A = S.make(Eigen::VectorXd::Zero(S.n()), q0, bridges0);
     R.stress0 = A.stress;
     R.residual0 = A.residual();

@@ -181,6 +181,25 @@ TEST_CASE("free box: beta = 0 keeps the dry network's stress-free reference", "[
     }
 }
 
+TEST_CASE("free box: an empty network's free box is the given one, exactly", "[wet][free_box][edge]") {
+    // Its stress scale is 0: the search divided by it (NaN residuals) and walked the box out to 2.05 I.
+    Network net;
+    net.L = 3;
+    const Model m = model_of(net, 10);
+    for (bool iso : {true, false}) {
+        const Eigen::Matrix2d F0 = 1.02 * Eigen::Matrix2d::Identity();
+        const WetRun r = run_wet(net, m, F0, options(1, iso, 1e-3));
+        INFO(r.free_box.message);
+        REQUIRE(r.free_box.attempted);
+        CHECK(r.free_box.converged);
+        CHECK(r.free_box.F == F0);
+        CHECK(r.free_box.areal_shrinkage == 0);
+        CHECK(r.free_box.s == 1);
+        CHECK(r.free_box.residual == 0);
+        CHECK(r.free_box.stress.sigma.isZero(0));
+    }
+}
+
 TEST_CASE("free box: capillary load shrinks a sparse network to zero stress", "[wet][free_box]") {
     // pl = 0.8 at q = 6: capillary bridges pull the network together (tension at the fixed box).
     const Network net = mikado(2.5, 6, 0.8, 2);
