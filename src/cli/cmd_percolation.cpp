@@ -46,6 +46,21 @@ std::string csv_line(const PercolationSample& s) {
 
 using Key = std::tuple<std::string, std::string, int>;  // L, q as written, sample
 
+// Refuses a row that percolation_sample cannot have written (at: "file:line: ").
+void check_row(const PercolationSample& s, int rigid, int conn, const std::string& at) {
+    auto bad = [&](const std::string& what) { throw InputError(at + what); };
+    if (!(std::isfinite(s.L) && s.L > 0)) bad("L = " + fmt(s.L) + " is not a box size > 0");
+    if (!(std::isfinite(s.q) && s.q > 0)) bad("q = " + fmt(s.q) + " is not a density > 0");
+    if (s.sample < 0) bad("sample = " + std::to_string(s.sample) + " is negative");
+    if (s.fibers < 0) bad("fibers = " + std::to_string(s.fibers) + " is negative");
+    if (s.d < 0 || s.d > 3) bad("d = " + std::to_string(s.d) + " is not a clamp's degrees of freedom (0..3)");
+    if (rigid != (s.d == 0 ? 1 : 0))
+        bad("rigid_spanning = " + std::to_string(rigid) + " contradicts d = " + std::to_string(s.d) + " (rigid iff d = 0)");
+    if (conn != 0 && conn != 1) bad("connected_spanning = " + std::to_string(conn) + " is not 0 or 1");
+    if (rigid && !conn) bad("rigid_spanning = 1 with connected_spanning = 0 (a rigid cluster is connected)");
+    if (!(std::isfinite(s.seconds) && s.seconds >= 0)) bad("seconds = " + fmt(s.seconds) + " is not a duration");
+}
+
 // Reads the rows of an existing CSV; lines that do not parse (an interrupted write) are skipped. Refuses rows that
 // this run's --pl and --seed would not have made: resuming them would mix two runs. seed_of(row) is the seed the
 // base seed gives for the row's L, q and sample, where it can be known: on this run's grid, or off it (an L left out
@@ -62,6 +77,7 @@ std::vector<PercolationSample> read_rows(const std::string& path, double pl, std
     std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (!all.empty()) ends_with_newline = all.back() == '\n';
     std::istringstream is(all);
+    std::map<Key, int> seen;  // line of each sample
     while (std::getline(is, line)) {
         ++lineno;
         if (lineno == 1) {
@@ -74,9 +90,14 @@ std::vector<PercolationSample> read_rows(const std::string& path, double pl, std
         if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%d,%llu,%d,%d,%d,%d,%lf", &s.pl, &s.L, &s.q, &s.sample, &seed, &s.fibers,
                         &s.d, &rigid, &conn, &s.seconds) != 10)
             continue;
-        if (std::abs(s.pl - pl) > 1e-12)
-            throw InputError(path + ":" + std::to_string(lineno) + ": pl = " + fmt(s.pl) + " differs from --pl " + fmt(pl));
+        const std::string at = path + ":" + std::to_string(lineno) + ": ";
+        if (std::abs(s.pl - pl) > 1e-12) throw InputError(at + "pl = " + fmt(s.pl) + " differs from --pl " + fmt(pl));
+        check_row(s, rigid, conn, at);
         s.seed = seed, s.rigid = rigid, s.connected = conn;
+        const auto [it, fresh] = seen.emplace(Key{fmt(s.L), fmt(s.q), s.sample}, lineno);
+        if (!fresh)
+            throw InputError(at + "L = " + fmt(s.L) + ", q = " + fmt(s.q) + ", sample " + std::to_string(s.sample) +
+                             " is already on line " + std::to_string(it->second) + " (a sample counts once)");
         const std::optional<std::uint64_t> expected = seed_of(s);
         if (expected && s.seed != *expected)
             throw InputError(path + ":" + std::to_string(lineno) + ": seed = " + std::to_string(s.seed) + " of L = " +

@@ -2,6 +2,9 @@
 // percolation --resume refuses another --seed; compare reports progress per network.
 #include <catch2/catch.hpp>
 
+#include <sstream>
+#include <vector>
+
 #include "../support/cli_run.hpp"
 
 using namespace clitest;
@@ -47,6 +50,46 @@ TEST_CASE("cli percolation: --resume refuses samples of another --seed", "[cli][
     const std::string other = "percolation --pl 1 --L 4 --q-min 4 --q-max 5 --q-step 1 --samples 2 --out " + csv;
     CHECK(run(other + " --seed 8 --resume") == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("is not the seed --seed 8 gives") != std::string::npos);
+}
+
+TEST_CASE("cli percolation: --resume refuses rows no run writes, and a sample twice", "[cli][percolation][input]") {
+    // A duplicated row was counted twice, and rigid_spanning = 7 was taken as rigid.
+    const std::string csv = tmpdir() + "/perc_rows.csv";
+    const std::string base = "percolation --pl 1 --L 3 --q-min 4 --q-max 5 --q-step 1 --seed 3 --out " + csv;
+    REQUIRE(run(base + " --samples 2") == 0);
+    const std::string rows = slurp(csv);
+    const auto second = rows.find('\n') + 1, third = rows.find('\n', second) + 1;
+    const std::string row = rows.substr(second, third - second);  // L,q,sample,seed,fibers,d,rigid,connected
+    auto field = [&](int k, const std::string& value) {  // the first data row with field k replaced
+        std::vector<std::string> f;
+        std::istringstream is(row.substr(0, row.size() - 1));
+        for (std::string x; std::getline(is, x, ',');) f.push_back(x);
+        f[k] = value;
+        std::string line;
+        for (size_t i = 0; i < f.size(); ++i) line += (i ? "," : "") + f[i];
+        return rows.substr(0, second) + line + "\n" + rows.substr(third);
+    };
+    struct Case {
+        std::string csv, message;
+    };
+    const Case cases[] = {
+        {rows + row, "is already on line 2 (a sample counts once)"},
+        {field(7, "7"), "rigid_spanning = 7 contradicts d = "},
+        {field(8, "2"), "connected_spanning = 2 is not 0 or 1"},
+        {field(6, "5"), "d = 5 is not a clamp's degrees of freedom"},
+        {field(3, "-1"), "sample = -1 is negative"},
+        {field(9, "-3"), "seconds = -3 is not a duration"},
+    };
+    for (const auto& c : cases) {
+        INFO(c.message);
+        write(csv, c.csv);
+        CHECK(run(base + " --samples 3 --resume") == 2);
+        CHECK(slurp(tmpdir() + "/stderr").find(csv + ":") != std::string::npos);
+        CHECK(slurp(tmpdir() + "/stderr").find(c.message) != std::string::npos);
+        CHECK(slurp(csv) == c.csv);
+    }
+    write(csv, rows);
+    CHECK(run(base + " --samples 3 --resume") == 0);
 }
 
 TEST_CASE("cli compare: --out is checked first; progress per network on stderr, -q silences it", "[cli][compare]") {
