@@ -28,6 +28,14 @@ void Scene::check() const {
     if (wet.crossings != "fraction" && wet.seed != 1)  // the seed of that draw, likewise (--wet-seed)
         throw InputError(source + ": [wet].seed = " + std::to_string(wet.seed) + " is used only with crossings = "
                          "fraction (crossings is '" + wet.crossings + "')");
+    // The law file last: a --law flag replaces the scene's before any file is opened.
+    if (!wet.law.empty()) {
+        try {
+            CapillaryLaw::read(wet.law);  // a malformed table names its file and row
+        } catch (const InputError& e) {
+            throw InputError(source + ": [wet].law: " + e.what());
+        }
+    }
 }
 
 void Scene::check_values() const {
@@ -52,13 +60,6 @@ void Scene::check_values() const {
     if (wet.free_box_shape != "full" && wet.free_box_shape != "isotropic")
         throw InputError(source + ": [wet].free_box_shape = '" + wet.free_box_shape +
                          "' is unknown (expected isotropic or full)");
-    if (!wet.law.empty()) {
-        try {
-            CapillaryLaw::read(wet.law);  // a malformed table names its file and row
-        } catch (const InputError& e) {
-            throw InputError(source + ": [wet].law: " + e.what());
-        }
-    }
 }
 
 namespace {
@@ -243,6 +244,9 @@ Scene load_scene(const std::string& path) {
     // A network file named in a scene is found next to the scene, wherever it is run from.
     if (!s.network_file.empty() && std::filesystem::path(s.network_file).is_relative())
         s.network_file = (std::filesystem::path(path).parent_path() / s.network_file).string();  // ".." as the OS resolves it
+    // So is a law table.
+    if (!s.wet.law.empty() && std::filesystem::path(s.wet.law).is_relative())
+        s.wet.law = (std::filesystem::path(path).parent_path() / s.wet.law).string();
     if (!s.network_file.empty() && !std::filesystem::is_regular_file(s.network_file))
         throw InputError(path + ": [network].file = '" + s.network_file + "' is not a readable file");
     return s;

@@ -213,6 +213,20 @@ TEST_CASE("cli wet: --free-box reports the zero-stress box, and exit 1 when it i
     CHECK(k.find("\"status\": \"free_box_not_converged\"") != std::string::npos);
 }
 
+TEST_CASE("cli wet: a scene's law file is found next to the scene, and --law replaces it unopened", "[wet][cli]") {
+    // Before, a scene's law was opened relative to the current directory, and also when --law replaced it.
+    const std::string dir = tmpdir() + "/lawdir", out = tmpdir() + "/lawrun";
+    REQUIRE(std::system(("rm -rf " + dir + " " + out + " && mkdir -p " + dir).c_str()) == 0);
+    write(dir + "/law.txt", "0 -1\n90 0\n");
+    write(dir + "/near.toml", "[network]\nL = 2.5\nq = 5\n[wet]\nlaw = \"law.txt\"\nbeta = 0\n");
+    write(dir + "/gone.toml", "[network]\nL = 2.5\nq = 5\n[wet]\nlaw = \"no_such_law.txt\"\nbeta = 0\n");
+    CHECK(run(dir + "/near.toml --no-moduli -q -o " + out) == 0);  // run from another directory
+    CHECK(read_json(out + "/summary.json")["wet"]["law"] == dir + "/law.txt");
+    CHECK(run(dir + "/gone.toml --no-moduli -q -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find(dir + "/no_such_law.txt") != std::string::npos);
+    CHECK(run(dir + "/gone.toml --law " + dir + "/law.txt --no-moduli -q -o " + out) == 0);
+}
+
 TEST_CASE("cli wet: summary.json records what reproduces the run", "[wet][cli]") {
     const std::string out = tmpdir() + "/record", law = tmpdir() + "/record_law.txt", scene = tmpdir() + "/record.toml";
     REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
