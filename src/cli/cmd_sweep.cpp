@@ -272,11 +272,18 @@ void register_sweep(CLI::App& app) {
                           << "  K = " << r.K << "  iterations = " << r.iterations << "  retries = " << r.retries
                           << "  " << r.seconds << " s\n";
         };
-        std::signal(SIGINT, on_signal);
-        std::signal(SIGTERM, on_signal);
+        // Ctrl-C and SIGTERM end the sweep after the step in progress, unless the caller ignores them (a background
+        // job of a script inherits SIGINT ignored): that disposition is kept.
+        struct sigaction stop_sa {}, old_int {}, old_term {};
+        stop_sa.sa_handler = on_signal;
+        sigemptyset(&stop_sa.sa_mask);
+        sigaction(SIGINT, nullptr, &old_int);
+        sigaction(SIGTERM, nullptr, &old_term);
+        if (old_int.sa_handler != SIG_IGN) sigaction(SIGINT, &stop_sa, nullptr);
+        if (old_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &stop_sa, nullptr);
         const SweepOutcome o = run_sweep(e, *p, *solver, cb, *resume ? &start : nullptr, snap.get());
-        std::signal(SIGINT, SIG_DFL);
-        std::signal(SIGTERM, SIG_DFL);
+        sigaction(SIGINT, &old_int, nullptr);
+        sigaction(SIGTERM, &old_term, nullptr);
         if (o.completed && rows > 0) write_checkpoint(*ckpt, params, rows, last, true);
         emit_json({{"status", o.completed ? "completed" : o.interrupted ? "interrupted" : "failed"},
                    {"message", o.message},
