@@ -288,6 +288,7 @@ void register_wet(CLI::App& app) {
         s.source = flags->scene_file.empty() ? "command line" : flags->scene_file + " + command line";
         s.check();
         const std::vector<double> betas = w->betas.empty() ? std::vector<double>{s.wet.beta} : parse_betas(w->betas);
+        for (double b : betas) s.check_beta(b, "command line", "--betas entry");
 
         WetRunOptions opt;
         std::string law_text;  // recorded in the summary: the file may change or go

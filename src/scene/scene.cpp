@@ -28,6 +28,7 @@ void Scene::check() const {
     if (wet.crossings != "fraction" && wet.seed != 1)  // the seed of that draw, likewise (--wet-seed)
         throw InputError(source + ": [wet].seed = " + std::to_string(wet.seed) + " is used only with crossings = "
                          "fraction (crossings is '" + wet.crossings + "')");
+    check_beta(wet.beta, source, "[wet].beta");
     // The law file last: a --law flag replaces the scene's before any file is opened.
     if (!wet.law.empty()) {
         try {
@@ -36,6 +37,14 @@ void Scene::check() const {
             throw InputError(source + ": [wet].law: " + e.what());
         }
     }
+}
+
+void Scene::check_beta(double beta, const std::string& where, const std::string& name) const {
+    const double stretch = 4 * discretization.aspect_ratio * discretization.aspect_ratio;
+    check_value(beta >= 0, beta, where, name, "must be >= 0");
+    check_value(beta <= kMaxBetaOverStretch * stretch, beta, where, name,
+                "exceeds the stretching stiffness 4 a^2 = " + show(stretch) + " (a = " + show(discretization.aspect_ratio) +
+                    "): capillary forces would crush the fibers axially, outside the model");
 }
 
 void Scene::check_values() const {

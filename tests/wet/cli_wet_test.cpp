@@ -139,6 +139,8 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
     write(unsorted, "0 -1\n60 -0.2\n30 -0.7\n90 0\n");
     const std::string latin1 = tmpdir() + "/latin1.txt";  // its text goes into summary.json: exit 3 before
     write(latin1, "# r\xe9sultats Surface Evolver\n0 -1\n90 0\n");
+    const std::string huge = tmpdir() + "/huge.txt";
+    write(huge, "0 -1e6\n90 0\n");
     write(scene, "[network]\nL = 2.5\nq = 5\n[wet]\nfraction = 1.5\n");
     struct Case {
         std::string args, needle;
@@ -150,6 +152,11 @@ TEST_CASE("cli wet: bad input exits 2 and names the value", "[wet][cli]") {
                           Case{"--crossings some", "some"}, Case{"--law " + law, "100"},
                           Case{"--law " + unsorted, "30"}, Case{scene, "fraction = 1.5"},
                           Case{"--law " + latin1, "latin1.txt:1: byte 0xe9 at column 4 is not UTF-8"},
+                          // Magnitudes outside the model (a run with --beta 1e9 grew to 98,625 bridges on 38 fibers).
+                          Case{"--beta 1e9", "[wet].beta = 1000000000 exceeds the stretching stiffness 4 a^2 = 400"},
+                          Case{"--betas 0,500", "--betas entry = 500 exceeds the stretching stiffness"},
+                          Case{"--a 3 --beta 40", "4 a^2 = 36 (a = 3)"},
+                          Case{"--law " + huge, "huge.txt: row 1: value = -1000000 is not E / (beta l) of order 1"},
                           Case{"--prune ends", "prune \"ends\" is not valid for `fibernet wet`"},
                           Case{"--free-box --open", "periodic"}, Case{"--free-box --free-box-shape round", "round"},
                           Case{"--free-box --free-box-tol 0", "free_box_tol = 0"},

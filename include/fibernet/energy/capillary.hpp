@@ -15,6 +15,13 @@
 
 namespace fibernet {
 
+// Largest |E / (beta l)| a tabulated law may give: the law's shape is of order 1, its strength is beta.
+constexpr double kMaxLawValue = 10;
+// Largest beta relative to the stretching stiffness 4 a^2 (energy per unit length, seed eq. 4.14): a bundle's
+// adhesion beta compresses a segment by eps ~ beta / (8 a^2), so beta = 4 a^2 is a 50% axial strain, far outside a
+// model of nearly inextensible fibers (and the softcore takes over at eps* = -0.95).
+constexpr double kMaxBetaOverStretch = 1;
+
 class CapillaryLaw {
 public:
     CapillaryLaw() = default;  // phi(c) = -c

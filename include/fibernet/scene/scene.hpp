@@ -56,6 +56,8 @@ struct Scene {
 
     void check() const;         // throws InputError naming the bad value and the scene's source
     void check_values() const;  // each value alone (parse_scene); check() adds their combinations (load, wet fraction)
+    // beta in [0, 4 a^2] (energy/capillary.hpp, kMaxBetaOverStretch); the message is "<where>: <name> = <beta> ...".
+    void check_beta(double beta, const std::string& where, const std::string& name) const;
 };
 
 // Parses a TOML scene; unknown tables/keys and wrong types are InputErrors naming file and key.
