@@ -91,3 +91,17 @@ TEST_CASE("cli: a result that cannot be written exits 4 naming where it went", "
     CHECK(slurp(err).find("cannot write output '/dev/full' (No space left on device)") != std::string::npos);
     CHECK(rc_of("modulus --L 3 --q 8 --scheme even -q >/dev/null") == 0);  // a device that takes the bytes is fine
 }
+
+TEST_CASE("cli: paths that are not UTF-8 are used as given and echoed with U+FFFD", "[cli][input]") {
+    // A Latin-1 directory name ended in exit 3 ("invalid UTF-8 byte") where a path went into the JSON results.
+    const std::string d = tmpdir() + "/r\xe9s";
+    REQUIRE(std::system(("mkdir -p '" + d + "'").c_str()) == 0);
+    REQUIRE(run("generate --L 3 --q 4 -o '" + d + "/n.net'") == 0);
+    clitest::write(d + "/s.toml", "[network]\nL = 3\nq = 8\n[model]\nscheme = \"even\"\n");
+    CHECK(run("modulus '" + d + "/s.toml' -q") == 0);
+    CHECK(slurp(tmpdir() + "/stdout").find("r\xef\xbf\xbds/s.toml") != std::string::npos);  // U+FFFD for the 0xe9
+    CHECK(run("wet --network '" + d + "/n.net' --betas 0.01 --no-moduli -q -o '" + d + "/out'") == 0);
+    CHECK(exists(d + "/out/summary.json"));
+    CHECK(run("sweep --network '" + d + "/n.net' --scheme even --gamma-max 0.02 -q -o '" + d + "/sw.csv'") == 0);
+    CHECK(run("sweep --network '" + d + "/n.net' --scheme even --gamma-max 0.02 -q --resume -o '" + d + "/sw.csv'") == 0);
+}
