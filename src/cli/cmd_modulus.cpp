@@ -95,17 +95,21 @@ void register_modulus(CLI::App& app) {
                 moduli[M.name + "_affine"] = M.affine;
                 moduli[M.name + "_ratio"] = number_or_null(M.affine != 0 ? M.value / M.affine : NAN, M.ok);
                 moduli[M.name + "_error"] = number_or_null(M.error, M.ok);
+                moduli[M.name + "_state_error"] = number_or_null(M.state_error, M.ok && info.state_checked);
                 moduli[M.name + "_refinements"] = M.refinements;
             }
             lin = {{"shift", info.delta},
                    {"factorizations", info.factorizations},
                    {"message", info.message},
+                   {"state_checked", info.state_checked},
+                   {"state_step", info.state_step},
                    {"seconds",
                     {{"assembly", info.seconds_assembly},
                      {"factorization", info.seconds_factorization},
                      {"one_factorization", info.seconds_one_factorization},
                      {"solve", info.seconds_solve},
                      {"affine", info.seconds_affine},
+                     {"state", info.seconds_state},
                      {"total", info.seconds_total}}}};
         }
         emit_json({{"scene", s.source},

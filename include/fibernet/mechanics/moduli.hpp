@@ -8,8 +8,9 @@
 // factorization of H + delta I (delta = 1e-12 median |diag H|, grown on failure), used as the preconditioner of
 // conjugate gradients on H u = E_xt: the preconditioned spectrum lambda / (lambda + delta) is 1 except for the few
 // modes with lambda ~ delta, so CG converges in a handful of steps, each one solve and no new factorization;
-// from u_0 = 0 it never enters the null space (the residual stays in range(H)). The last increments of
-// E_xt.u bound the remaining error (reported as `error`). The shift is not a bias: CG removes it.
+// from u_0 = 0 it never enters the null space (the residual stays in range(H)). The shift is not a bias: CG removes
+// it. `error` estimates what the solve and the state leave (docs/moduli.md "Error estimates"): the CG's tail, what
+// its true residual shows, and the change one Newton step away from q.
 //
 // Normalisations (2D, current box area A):
 //   shear  G: dF = e_x e_y^T F (simple shear of the current state), G = (1/A) d2E/dt2;
@@ -40,7 +41,10 @@ struct Modulus {
     double value = 0;       // scale * (E_tt - E_xt^T H^+ E_xt); NaN when !ok
     double affine = 0;      // scale * E_tt of the affinely deformed reference (the affine prediction)
     double E_tt = 0, correction = 0;  // unscaled affine (comoving) part and non-affine correction at the equilibrium
-    double error = 0;       // bound on |value error| from the refinement (scaled)
+    // Estimated |value error| (scaled): the largest of the CG's tail, the cancellation's round-off, the error the
+    // solve's true residual shows, and (linear_moduli, ModuliOptions::state_error) state_error.
+    double error = 0;
+    double state_error = 0;  // |value at q' - value at q|, q' one Newton step from q: the state's share
     int refinements = 0;        // conjugate-gradient steps
     bool stalled = false;       // round-off stopped the conjugate gradients before they converged
     Eigen::VectorXd response;   // a solution of H r = E_xt: dq/dt = -response along the mode
@@ -54,6 +58,10 @@ struct ModuliOptions {
     // linear_moduli: q must be an equilibrium, max|g| <= max(equilibrium_tol, the round-off floor of the coordinates
     // (roundoff_floor, newton.hpp)); otherwise every modulus is refused (ok = false, the message says why).
     double equilibrium_tol = 1e-6;
+    // linear_moduli: also compute the moduli one Newton step away and count their difference in `error` (an
+    // equilibrium is known only to tol or the round-off floor; one more factorization). Off in sweeps, which report
+    // no errors.
+    bool state_error = true;
 };
 
 struct ModuliInfo {
@@ -62,6 +70,9 @@ struct ModuliInfo {
     int factorizations = 0;
     double seconds_assembly = 0, seconds_factorization = 0, seconds_solve = 0, seconds_affine = 0, seconds_total = 0;
     double seconds_one_factorization = 0;   // the successful factorization alone, for the modulus/factorization ratio
+    bool state_checked = false;  // the state's share of the errors was estimated (ModuliOptions::state_error)
+    double state_step = 0;       // max |q' - q| of that Newton step
+    double seconds_state = 0;
     std::string message;
 };
 
