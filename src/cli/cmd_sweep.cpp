@@ -285,11 +285,14 @@ void register_sweep(CLI::App& app) {
         sigaction(SIGINT, &old_int, nullptr);
         sigaction(SIGTERM, &old_term, nullptr);
         if (o.completed && rows > 0) write_checkpoint(*ckpt, params, rows, last, true);
+        // A sweep that failed before its first row (the reference state's linear response) leaves no files: a CSV
+        // of its header alone would read as a sweep with no steps.
+        if (rows == 0) std::remove(out->c_str());
         emit_json({{"status", o.completed ? "completed" : o.interrupted ? "interrupted" : "failed"},
                    {"message", o.message},
                    {"rows", rows},
-                   {"output", *out},
-                   {"checkpoint", *ckpt},
+                   {"output", rows > 0 ? nlohmann::json(*out) : nlohmann::json()},
+                   {"checkpoint", rows > 0 ? nlohmann::json(*ckpt) : nlohmann::json()},
                    {"model", to_json(summarize(m))}});
         if (o.interrupted) exit_code() = 130;
         else if (!o.completed) exit_code() = 1;
