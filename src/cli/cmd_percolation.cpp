@@ -8,10 +8,13 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <charconv>
 #include <map>
 #include <optional>
 #include <mutex>
@@ -19,6 +22,7 @@
 #include <sstream>
 #include <thread>
 #include <tuple>
+#include <vector>
 
 #include "common.hpp"
 #include "fibernet/util/error.hpp"
@@ -45,6 +49,26 @@ std::string csv_line(const PercolationSample& s) {
 }
 
 using Key = std::tuple<std::string, std::string, int>;  // L, q as written, sample
+
+// Splits a CSV row into the 10 fields csv_line writes, each parsed whole: integers in range of their type (sscanf's
+// %d wrapped 4294967296 to 0), decimals as written. False for a line that is not such a row (an interrupted write).
+bool parse_row(const std::string& line, PercolationSample& s, std::uint64_t& seed, int& rigid, int& conn) {
+    std::vector<std::string> f;
+    std::istringstream is(line);
+    for (std::string x; std::getline(is, x, ',');) f.push_back(x);
+    if (f.size() != 10) return false;
+    auto real = [](const std::string& t, double& v) {
+        char* end = nullptr;
+        v = std::strtod(t.c_str(), &end);
+        return !t.empty() && !*end && t.find_first_not_of("0123456789+-.eE") == std::string::npos;
+    };
+    auto whole = [](const std::string& t, auto& v) {
+        const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+        return !t.empty() && r.ec == std::errc() && r.ptr == t.data() + t.size();
+    };
+    return real(f[0], s.pl) && real(f[1], s.L) && real(f[2], s.q) && whole(f[3], s.sample) && whole(f[4], seed) &&
+           whole(f[5], s.fibers) && whole(f[6], s.d) && whole(f[7], rigid) && whole(f[8], conn) && real(f[9], s.seconds);
+}
 
 // Refuses a row that percolation_sample cannot have written (at: "file:line: ").
 void check_row(const PercolationSample& s, int rigid, int conn, const std::string& at) {
@@ -86,10 +110,8 @@ std::vector<PercolationSample> read_rows(const std::string& path, double pl, std
         }
         PercolationSample s;
         int rigid = 0, conn = 0;
-        unsigned long long seed = 0;
-        if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%d,%llu,%d,%d,%d,%d,%lf", &s.pl, &s.L, &s.q, &s.sample, &seed, &s.fibers,
-                        &s.d, &rigid, &conn, &s.seconds) != 10)
-            continue;
+        std::uint64_t seed = 0;
+        if (!parse_row(line, s, seed, rigid, conn)) continue;
         const std::string at = path + ":" + std::to_string(lineno) + ": ";
         if (std::abs(s.pl - pl) > 1e-12) throw InputError(at + "pl = " + fmt(s.pl) + " differs from --pl " + fmt(pl));
         check_row(s, rigid, conn, at);

@@ -3,6 +3,8 @@
 // stops after the step in progress, and --resume continues with results identical to an uninterrupted run.
 
 #include <atomic>
+#include <cmath>
+#include <cstdlib>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -11,6 +13,7 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <vector>
 
 #include "common.hpp"
 #include "fibernet/mechanics/sweep.hpp"
@@ -27,6 +30,7 @@ extern "C" void on_signal(int) { g_stop = true; }
 const char* kHeader =
     "step,gamma,sigma_xx,sigma_xy,sigma_yy,stress_path,K,K_affine,energy,stretch,bend,iterations,factorizations,"
     "retries,grad_max,seconds";
+constexpr size_t kColumns = 16;
 
 std::string csv_row(const SweepRow& r) {
     std::ostringstream os;
@@ -178,14 +182,20 @@ void truncate_csv(const std::string& path, int rows, double t) {
         if (!std::getline(is, line))
             fail("has " + std::to_string(n) + " rows, fewer than the checkpoint's " + std::to_string(rows));
         std::istringstream fields(line);
-        std::string step, gamma;
-        std::getline(fields, step, ','), std::getline(fields, gamma, ',');
-        if (step != std::to_string(n))
-            fail("row " + std::to_string(n + 1) + " is step '" + step + "', expected " + std::to_string(n));
-        char* end = nullptr;
-        const double g = std::strtod(gamma.c_str(), &end);
-        if (n + 1 == rows && (gamma.empty() || *end || g != t))  // 17 digits: the value round-trips exactly
-            fail("row " + std::to_string(rows) + " has gamma '" + gamma + "', the checkpoint's t = " + show(t));
+        std::vector<std::string> f;
+        for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+        const std::string row = "row " + std::to_string(n + 1);
+        if (f.size() != kColumns)
+            fail(row + " has " + std::to_string(f.size()) + " fields, expected " + std::to_string(kColumns));
+        if (f[0] != std::to_string(n)) fail(row + " is step '" + f[0] + "', expected " + std::to_string(n));
+        for (size_t k = 1; k < f.size(); ++k) {  // every value the sweep writes is a finite number
+            char* end = nullptr;
+            const double v = std::strtod(f[k].c_str(), &end);
+            if (f[k].empty() || *end || !std::isfinite(v) || f[k].find_first_not_of("0123456789+-.eE") != std::string::npos)
+                fail(row + " field " + std::to_string(k + 1) + " is '" + f[k] + "', not a number the sweep writes");
+        }
+        if (n + 1 == rows && std::strtod(f[1].c_str(), nullptr) != t)  // 17 digits: the value round-trips exactly
+            fail("row " + std::to_string(rows) + " has gamma '" + f[1] + "', the checkpoint's t = " + show(t));
         kept += line + "\n";
     }
     write_file_atomic(path, kept);

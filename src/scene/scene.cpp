@@ -244,11 +244,12 @@ Scene load_scene(const std::string& path) {
     ss << is.rdbuf();
     // Another of fibernet's files given where a scene is expected: say what it is and where it goes.
     const std::string text = ss.str();
+    const std::string body = text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text;  // a UTF-8 BOM
     for (const auto& [magic, what] : std::vector<std::array<std::string, 2>>{
              {"fibernet-network", "a network file, not a scene (TOML): give it as --network " + path},
              {"fibernet-model", "a model file (what export and relax write), not a scene (TOML)"},
              {"fibernet-sweep-checkpoint", "a sweep checkpoint, not a scene (TOML): continue its sweep with sweep --resume"}})
-        if (text.rfind(magic, 0) == 0) throw InputError("'" + path + "' is " + what);
+        if (body.rfind(magic, 0) == 0) throw InputError("'" + path + "' is " + what);
     Scene s = parse_scene(text, path);
     // A network file named in a scene is found next to the scene, wherever it is run from.
     if (!s.network_file.empty() && std::filesystem::path(s.network_file).is_relative())

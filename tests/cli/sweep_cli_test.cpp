@@ -179,6 +179,22 @@ TEST_CASE("cli sweep: --resume refuses checkpoint fields and CSV rows no sweep w
     CHECK(run(net + csv + " --resume") == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("row 2 is step '7', expected 1") != std::string::npos);
     CHECK(slurp(csv) == bad);
+    // Every value of the kept rows (NaN, '1e', a hex float survived into the resumed CSV).
+    for (const std::string value : {"NaN", "1e", "0x1p3", ""}) {
+        INFO("sigma_xx = '" << value << "'");
+        bad = rows;
+        const auto at = bad.find("\n1,") + 1, f3 = bad.find(',', bad.find(',', at) + 1) + 1;
+        bad.replace(f3, bad.find(',', f3) - f3, value);
+        write(csv, bad);
+        CHECK(run(net + csv + " --resume") == 2);
+        CHECK(slurp(tmpdir() + "/stderr").find("row 2 field 3 is '" + value + "', not a number the sweep writes") !=
+              std::string::npos);
+    }
+    bad = rows;
+    bad.replace(bad.find("\n1,") + 1, 2, "1,2,");
+    write(csv, bad);
+    CHECK(run(net + csv + " --resume") == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("row 2 has 17 fields, expected 16") != std::string::npos);
     write(csv, rows);
     CHECK(run(net + csv + " --resume") == 0);  // the checkpoint as written resumes
     CHECK(slurp(csv) == rows);

@@ -83,6 +83,8 @@ TEST_CASE("scene: another of fibernet's files given as the scene is named for wh
     CHECK_THROWS_WITH(load_scene(dir + "/n.net"),
                       Catch::Contains("n.net' is a network file, not a scene (TOML): give it as --network " + dir + "/n.net"));
     CHECK_THROWS_WITH(load_scene(dir + "/m.txt"), Catch::Contains("m.txt' is a model file"));
+    std::ofstream(dir + "/bom.net") << "\xEF\xBB\xBF" << "fibernet-network 1\nbox 10 open\nfibers 0\ncrossings 0\n";
+    CHECK_THROWS_WITH(load_scene(dir + "/bom.net"), Catch::Contains("bom.net' is a network file"));  // saved with a BOM
     CHECK_THROWS_WITH(load_scene(dir + "/s.ckpt"), Catch::Contains("s.ckpt' is a sweep checkpoint"));
     std::ofstream(dir + "/t.toml") << "# fibernet-network 1 in a comment is still a scene\n[network]\nL = 4\n";
     CHECK(load_scene(dir + "/t.toml").mikado.L == 4);
