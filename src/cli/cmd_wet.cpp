@@ -442,8 +442,12 @@ void register_wet(CLI::App& app) {
                              r.active.seconds_solve + r.active.seconds_events);
             if (k == 0) dry_state = r.dry;
             const bool wet_good = r.dry.converged && r.wet.converged && r.active.stable;
-            const bool good = wet_good && (!opt.free_box.enabled || r.free_box.converged);
-            const char* bad = !wet_good ? "not_stable" : "free_box_not_converged";
+            const bool box_good = !opt.free_box.enabled || r.free_box.converged;
+            // Moduli asked for and not computed (a linear solve that failed) fail the run, as in `fibernet modulus`.
+            const bool moduli_good =
+                !opt.moduli || (std::isfinite(dry_state.shear_modulus) && std::isfinite(r.wet.shear_modulus));
+            const bool good = wet_good && box_good && moduli_good;
+            const char* bad = !wet_good ? "not_stable" : !box_good ? "free_box_not_converged" : "modulus_failed";
             ok = ok && good;
             const auto& pw = r.wet.pores.pores;
             double sum = 0, dsum = 0;
