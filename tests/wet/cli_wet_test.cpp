@@ -220,6 +220,22 @@ TEST_CASE("cli wet: --free-box reports the zero-stress box, and exit 1 when it i
     CHECK(k.find("\"status\": \"free_box_not_converged\"") != std::string::npos);
 }
 
+TEST_CASE("cli wet: a law file refused leaves a previous run's outputs as they were", "[wet][cli][input]") {
+    // A law with a Latin-1 comment left header-only CSVs and deleted the SVGs of the previous run in the directory.
+    const std::string out = tmpdir() + "/keep", law = tmpdir() + "/keep_law.txt";
+    REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
+    REQUIRE(run("--L 2.5 --q 5 --betas 0.01 --no-moduli -q -o " + out) == 0);
+    std::vector<std::string> before;
+    for (const char* f : {"summary.json", "sweep.csv", "pores.csv", "network.svg", "pores.svg"}) before.push_back(slurp(out + "/" + f));
+    write(law, "# r\xe9sultats\n0 -1\n90 0\n");
+    CHECK(run("--L 2.5 --q 5 --betas 0.01 --no-moduli -q --law " + law + " -o " + out) == 2);
+    size_t k = 0;
+    for (const char* f : {"summary.json", "sweep.csv", "pores.csv", "network.svg", "pores.svg"}) {
+        INFO(f);
+        CHECK(slurp(out + "/" + f) == before[k++]);
+    }
+}
+
 TEST_CASE("cli wet: a scene's law file is found next to the scene, and --law replaces it unopened", "[wet][cli]") {
     // Before, a scene's law was opened relative to the current directory, and also when --law replaced it.
     const std::string dir = tmpdir() + "/lawdir", out = tmpdir() + "/lawrun";
