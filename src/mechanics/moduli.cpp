@@ -202,12 +202,12 @@ struct CgScales {
 // L = 20). The iterates stay in range(H) when b does, and c_k = b.u_k rises monotonically to b.H^+ b. (Restarting
 // from the true residual B - H U was tried: on the seed scheme it chases the round-off of H U and moves c further.)
 template <class HView>
-std::vector<ModeCG> pcg_modes(const HView& Hs, const CholmodLLT& llt, const Eigen::MatrixXd& B, Eigen::MatrixXd& U,
-                              const CgScales& sc, const ModuliOptions& opt) {
+std::vector<ModeCG> pcg_modes(const HView& Hs, const CholmodLLT& llt, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Z0,
+                              Eigen::MatrixXd& U, const CgScales& sc, const ModuliOptions& opt) {
     const int M = static_cast<int>(B.cols());
     std::vector<ModeCG> st(M);
     U.setZero(B.rows(), M);
-    Eigen::MatrixXd R = B, Z = llt.solve_many(R), P = Z;
+    Eigen::MatrixXd R = B, Z = Z0, P = Z;  // Z0 = M B, the first preconditioner solve
     std::vector<double> rz(M);
     for (int m = 0; m < M; ++m) {
         rz[m] = sc.rz0[m];
@@ -400,7 +400,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
             scale_ref[m] = std::max({std::abs(out[m].E_tt), rz0[m], std::numeric_limits<double>::min()});
         }
         const CgScales sc{scale_ref, rz0, comoving_size, n};
-        const std::vector<ModeCG> cg = pcg_modes(Hs, llt, B, U, sc, opt);
+        const std::vector<ModeCG> cg = pcg_modes(Hs, llt, B, Z0, U, sc, opt);
         const std::vector<double> drift = true_residual_correction(Hs, llt, B, U);
         std::vector<char> broke(M);
         for (int m = 0; m < M; ++m) {
@@ -415,7 +415,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
             // What the CG says is left (its tail, floored at the cancellation's round-off), and at least what the true
             // residual says: the CG's own residual drifts from B - H U by round-off in H's stiff modes, and then its
             // tail is no bound (a seed-scheme G of -1.13e-6 reported +- 4e-10 on AVX2 kernels, +- 3.7e-8 and
-            // -4.3e-7 on AVX-512 ones at the same state; docs/moduli.md "Error bounds").
+            // -4.3e-7 on AVX-512 ones at the same state; docs/moduli.md "Error estimates").
             Mo.error = modes[m].scale * std::max(cg_error(r, sc, m), std::abs(drift[m]));
             // Accepted when converged, or stopped by round-off with the tail below 1e-7 of the cancellation scale
             // (the seed scheme's 1e-4 segments at L = 20 end there; the error is reported).
