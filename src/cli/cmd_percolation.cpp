@@ -57,11 +57,7 @@ bool parse_row(const std::string& line, PercolationSample& s, std::uint64_t& see
     std::istringstream is(line);
     for (std::string x; std::getline(is, x, ',');) f.push_back(x);
     if (f.size() != 10) return false;
-    auto real = [](const std::string& t, double& v) {
-        char* end = nullptr;
-        v = std::strtod(t.c_str(), &end);
-        return !t.empty() && !*end && t.find_first_not_of("0123456789+-.eE") == std::string::npos;
-    };
+    auto real = parse_decimal;
     auto whole = [](const std::string& t, auto& v) {
         const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
         return !t.empty() && r.ec == std::errc() && r.ptr == t.data() + t.size();

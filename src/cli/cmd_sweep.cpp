@@ -188,13 +188,11 @@ void truncate_csv(const std::string& path, int rows, double t) {
         if (f.size() != kColumns)
             fail(row + " has " + std::to_string(f.size()) + " fields, expected " + std::to_string(kColumns));
         if (f[0] != std::to_string(n)) fail(row + " is step '" + f[0] + "', expected " + std::to_string(n));
-        for (size_t k = 1; k < f.size(); ++k) {  // every value the sweep writes is a finite number
-            char* end = nullptr;
-            const double v = std::strtod(f[k].c_str(), &end);
-            if (f[k].empty() || *end || !std::isfinite(v) || f[k].find_first_not_of("0123456789+-.eE") != std::string::npos)
+        double v = 0, gamma = 0;
+        for (size_t k = 1; k < f.size(); ++k)  // every value the sweep writes is a finite number
+            if (!parse_decimal(f[k], k == 1 ? gamma : v))
                 fail(row + " field " + std::to_string(k + 1) + " is '" + f[k] + "', not a number the sweep writes");
-        }
-        if (n + 1 == rows && std::strtod(f[1].c_str(), nullptr) != t)  // 17 digits: the value round-trips exactly
+        if (n + 1 == rows && gamma != t)  // 17 digits: the value round-trips exactly
             fail("row " + std::to_string(rows) + " has gamma '" + f[1] + "', the checkpoint's t = " + show(t));
         kept += line + "\n";
     }

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
@@ -186,6 +187,13 @@ std::string file_bytes(const std::string& path, const std::string& what) {
     std::ostringstream os;
     if (!is || !(os << is.rdbuf())) throw InputError(what + " '" + path + "' cannot be read");
     return os.str();
+}
+
+bool parse_decimal(const std::string& text, double& v) {
+    if (text.empty() || text.find_first_not_of("0123456789+-.eE") != std::string::npos) return false;
+    char* end = nullptr;
+    v = std::strtod(text.c_str(), &end);
+    return !*end && std::isfinite(v);
 }
 
 std::string json_text(const nlohmann::json& j, int indent) {

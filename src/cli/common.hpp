@@ -69,6 +69,9 @@ nlohmann::json prune_rules(const Scene& s);  // the pruning rules applied, e.g. 
 nlohmann::json scene_parameters(const Scene& s);
 nlohmann::json to_json(const ModelSummary& s);
 
+// A number as fibernet writes it into its CSVs (decimal digits, sign, point, exponent; no nan, inf or hex), parsed
+// whole: false for anything else (a mangled row read back on --resume).
+bool parse_decimal(const std::string& text, double& v);
 // JSON text (indent -1: one line); bytes that are not UTF-8 become U+FFFD instead of an exception.
 std::string json_text(const nlohmann::json& j, int indent = -1);
 // Prints JSON to stdout (or to `path` atomically when non-empty).
