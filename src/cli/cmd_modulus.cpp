@@ -39,6 +39,7 @@ nlohmann::json stress_json(const Stress& s) {
 
 namespace {
 nlohmann::json number_or_null(double v, bool ok) { return ok && std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+bool info_shift_grown(const nlohmann::json& lin) { return lin.is_object() && lin.value("shift_grown", false); }
 }  // namespace
 
 void register_modulus(CLI::App& app) {
@@ -99,6 +100,7 @@ void register_modulus(CLI::App& app) {
                 moduli[M.name + "_refinements"] = M.refinements;
             }
             lin = {{"shift", info.delta},
+                   {"shift_grown", info.shift_grown},
                    {"factorizations", info.factorizations},
                    {"message", info.message},
                    {"state_checked", info.state_checked},
@@ -138,6 +140,12 @@ void register_modulus(CLI::App& app) {
             std::fprintf(stderr, "modulus: %s; the seed scheme's very short segments (shortest %.2g seed units here) make "
                                  "H ill-conditioned on large networks: --scheme even avoids them (docs/moduli.md)\n",
                          why.c_str(), summarize(m).shortest_segment);
+        // Accepted moduli of an H that needed a larger shift to factor: say that their errors may be understated.
+        if (ok && info_shift_grown(lin) && s.discretization.scheme == Scheme::Seed)
+            std::fprintf(stderr, "modulus: warning: H + delta I factored only at a shift grown to %.2g; the seed scheme's "
+                                 "very short segments (shortest %.2g seed units here) leave H ill-conditioned at round-off, "
+                                 "and the errors may be understated: --scheme even avoids them (docs/moduli.md)\n",
+                         lin["shift"].get<double>(), summarize(m).shortest_segment);
         if (!ok) exit_code() = 1;
     });
 }

@@ -383,6 +383,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
             inf.seconds_factorization += inf.seconds_one_factorization;
             ++inf.factorizations;
             if (factored) inf.delta = delta;
+            inf.shift_grown = inf.shift_grown || (factored && k > 0);  // in either attempt
         }
         if (!factored) {
             inf.message = "H + delta I is not positive definite up to delta = 1e2 diag scale of H: not a stable equilibrium";

@@ -119,6 +119,25 @@ TEST_CASE("cli modulus: a failed linear solve on the seed scheme says so and nam
     CHECK(err.find("--scheme even avoids them") != std::string::npos);
 }
 
+TEST_CASE("cli modulus: an ill-conditioned seed-scheme H is reported where its errors may be understated",
+          "[cli][modulus]") {
+    // At rest (the exact equilibrium) this network is floppy: G = 0 (the even scheme gives 1e-12). Its seed-scheme
+    // segment of 1e-5 leaves H + delta I unfactorable at the first shift, the CG misses soft modes, and G came out
+    // -9.3e-6 +- 2e-7, with nothing said. A modulus below -3 errors at rest must come with the warning.
+    REQUIRE(run("modulus --L 2.604 --q 10.7 --pl 0.495 --scheme seed --seed 3160941185") == 0);
+    const auto j = out();
+    const std::string err = slurp(dir() + "/stderr");
+    const bool grown = j["linear_solve"]["shift_grown"].get<bool>();
+    CHECK(grown == (err.find("the errors may be understated: --scheme even avoids them") != std::string::npos));
+    for (const char* m : {"G", "K"}) {
+        INFO(m << " = " << j["moduli"][m] << " +- " << j["moduli"][std::string(m) + "_error"]);
+        CHECK((grown || j["moduli"][m].get<double>() >= -3 * j["moduli"][std::string(m) + "_error"].get<double>()));
+    }
+    REQUIRE(run("modulus --L 2.604 --q 10.7 --pl 0.495 --scheme even --seed 3160941185") == 0);
+    CHECK(!out()["linear_solve"]["shift_grown"].get<bool>());
+    CHECK(slurp(dir() + "/stderr").find("may be understated") == std::string::npos);
+}
+
 TEST_CASE("cli modulus: bad input exits 2", "[cli][modulus][input]") {
     CHECK(run("modulus --L 3 --q 8 --solver nope") == 2);
     CHECK(slurp(dir() + "/stderr").find("nope") != std::string::npos);

@@ -66,6 +66,9 @@ struct ModuliOptions {
 
 struct ModuliInfo {
     double delta = 0;          // shift of the factorization used
+    // H + delta I failed to factor at the first shift (round-off made pivots negative): H is ill-conditioned at
+    // round-off, the CG resolves its soft modes poorly, and the errors may be understated (docs/moduli.md).
+    bool shift_grown = false;
     double grad_max = 0, grad_floor = 0;  // linear_moduli: max|g| at q and its round-off floor
     int factorizations = 0;
     double seconds_assembly = 0, seconds_factorization = 0, seconds_solve = 0, seconds_affine = 0, seconds_total = 0;
