@@ -661,7 +661,8 @@ def sweep_resume_check(base_csv, gmax, csv_mutated):
 
 
 DECIMAL = re.compile(rb"[0-9+\-.eE]+")
-INTEGER = re.compile(rb"[+-]?[0-9]+")
+INTEGER = re.compile(rb"-?[0-9]+")      # std::from_chars: no '+'
+UNSIGNED = re.compile(rb"[0-9]+")
 
 
 def strict_perc_row(line):
@@ -681,7 +682,7 @@ def strict_perc_row(line):
             except ValueError:
                 return None
         else:
-            if not INTEGER.fullmatch(tok):
+            if not (UNSIGNED if k == 4 else INTEGER).fullmatch(tok):
                 return None
             v = int(tok)
             lo, hi = (0, 2 ** 64) if k == 4 else (-2 ** 31, 2 ** 31)

@@ -206,6 +206,11 @@ def check_sweep(r, d):
     if st == "failed" and not j.get("message"):
         f.append(("status_mismatch", "failed without a message"))
     p = os.path.join(d, "s.csv")
+    if j.get("rows") == 0:  # failed before its first row: no files at all (docs/sweep.md)
+        left = [n for n in ("s.csv", "s.csv.ckpt") if os.path.exists(os.path.join(d, n))]
+        if left or j.get("output") is not None or j.get("checkpoint") is not None:
+            f.append(("partial_output", "no rows, yet %s left and output %r" % (left, j.get("output"))))
+        return f
     if not os.path.exists(p):
         return f + [("missing_output", "s.csv not written")]
     lines = open(p, encoding="utf-8", errors="replace").read().splitlines()
