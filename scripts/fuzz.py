@@ -40,7 +40,6 @@ import argparse
 import json
 import os
 import re
-import resource
 import shutil
 import signal
 import subprocess
@@ -48,6 +47,8 @@ import sys
 import tempfile
 import time
 import random
+
+from fibernet_runs import child_env, child_limits, parse_json
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FORMATS = ["network", "scene", "law", "sweep_ckpt", "percolation", "model", "foreign", "paths"]
@@ -369,16 +370,6 @@ def mutate(rng, b, kind, n=None):
 # running
 
 
-def child_limits():
-    resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))  # huge declared counts fail fast, not swap the box
-    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
-    resource.setrlimit(resource.RLIMIT_FSIZE, (256 << 20, 256 << 20))
-
-
-def child_env():
-    env = dict(os.environ)
-    env.update({"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "FIBERNET_THREADS": "1", "LC_ALL": "C"})
-    return env
 
 
 class Result:
@@ -389,7 +380,7 @@ def run(argv, cwd, timeout):
     r = Result()
     t0 = time.monotonic()
     p = subprocess.Popen(argv, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                         env=child_env(), preexec_fn=child_limits)
+                         env=child_env(), preexec_fn=lambda: child_limits(3, 256))
     r.timed_out = False
     try:
         r.out, r.err = p.communicate(timeout=timeout)
@@ -425,18 +416,6 @@ def snap_diff(a, b):
             out.append(("created " if k not in a else "removed " if k not in b else "changed ") + repr(k))
     return out
 
-
-def parse_json(text):
-    """Returns (object or None, error or None, nonfinite constants found)."""
-    bad = []
-
-    def const(c):
-        bad.append(c)
-        return float("nan")
-    try:
-        return json.loads(text.decode("utf-8"), parse_constant=const), None, bad
-    except (ValueError, UnicodeDecodeError) as e:
-        return None, str(e)[:200], bad
 
 
 def csv_rows(b):

@@ -34,7 +34,6 @@ import math
 import os
 import random
 import re
-import resource
 import shutil
 import signal
 import subprocess
@@ -42,6 +41,8 @@ import sys
 import tempfile
 import threading
 import time
+
+from fibernet_runs import child_env, child_limits, parse_json
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEFAULT_SEED = 20261201
@@ -53,15 +54,6 @@ BETAS = [0.0, 0.1]
 NONFINITE = re.compile(r"(?<![A-Za-z_])[-+]?(nan|inf|infinity)(?![A-Za-z_])", re.I)
 
 
-def child_limits():
-    resource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30))
-    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
-
-
-def child_env():
-    env = dict(os.environ)
-    env.update({"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "FIBERNET_THREADS": "1", "LC_ALL": "C"})
-    return env
 
 
 class Result:
@@ -73,7 +65,7 @@ def run(argv, cwd, timeout, stall=None):
     r = Result()
     t0 = time.monotonic()
     p = subprocess.Popen(argv, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                         env=child_env(), preexec_fn=child_limits)
+                         env=child_env(), preexec_fn=lambda: child_limits(4))
     out, err = [], []
     last = [time.monotonic()]
 
@@ -105,17 +97,6 @@ def run(argv, cwd, timeout, stall=None):
     r.seconds = time.monotonic() - t0
     return r
 
-
-def parse_json(text):
-    bad = []
-
-    def const(c):
-        bad.append(c)
-        return float("nan")
-    try:
-        return json.loads(text.decode("utf-8"), parse_constant=const), None, bad
-    except (ValueError, UnicodeDecodeError) as e:
-        return None, str(e)[:200], bad
 
 
 def num(x):
