@@ -124,12 +124,15 @@ TEST_CASE("cli modulus: an ill-conditioned seed-scheme H is reported where its e
     // At rest (the exact equilibrium) this network is floppy: G = 0 (the even scheme gives 1e-12). Its seed-scheme
     // segment of 1e-5 leaves H + delta I unfactorable at the first shift, the CG misses soft modes, and G came out
     // -9.3e-6 +- 2e-7, with nothing said. A modulus below -3 errors at rest must come with the warning.
-    REQUIRE(run("modulus --L 2.604 --q 10.7 --pl 0.495 --scheme seed --seed 3160941185") == 0);
+    const int rc = run("modulus --L 2.604 --q 10.7 --pl 0.495 --scheme seed --seed 3160941185");
     const auto j = out();
     const std::string err = slurp(dir() + "/stderr");
+    // Whether the seed scheme's CG is accepted here is round-off (another CPU may refuse it): then it says so.
+    REQUIRE((rc == 0 || (rc == 1 && j["status"] == "modulus_failed")));
     const bool grown = j["linear_solve"]["shift_grown"].get<bool>();
-    CHECK(grown == (err.find("the errors may be understated: --scheme even avoids them") != std::string::npos));
+    if (rc == 0) CHECK(grown == (err.find("the errors may be understated: --scheme even avoids them") != std::string::npos));
     for (const char* m : {"G", "K"}) {
+        if (j["moduli"][m].is_null()) continue;  // refused: no value to judge
         INFO(m << " = " << j["moduli"][m] << " +- " << j["moduli"][std::string(m) + "_error"]);
         CHECK((grown || j["moduli"][m].get<double>() >= -3 * j["moduli"][std::string(m) + "_error"].get<double>()));
     }
