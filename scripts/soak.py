@@ -144,13 +144,18 @@ def check_common(r, cmd):
     return [], None
 
 
-def check_modulus(r, d, allow_negative):
-    f = []
+def stdout_json(r):
+    """The run's JSON on stdout and the failures reading it shows: (None, [bad_json]) if it does not parse."""
     j, err, bad = parse_json(r.out)
     if err:
-        return [("bad_json", err)]
-    if bad:
-        f.append(("nonfinite_output", "stdout JSON has %s" % bad))
+        return None, [("bad_json", err)]
+    return j, [("nonfinite_output", "stdout JSON has %s" % bad)] if bad else []
+
+
+def check_modulus(r, d, allow_negative):
+    j, f = stdout_json(r)
+    if j is None:
+        return f
     st = j.get("status")
     if (r.rc == 0) != (st == "converged"):
         f.append(("status_mismatch", "exit %d with status %r" % (r.rc, st)))
@@ -175,12 +180,9 @@ def check_modulus(r, d, allow_negative):
 
 
 def check_sweep(r, d):
-    f = []
-    j, err, bad = parse_json(r.out)
-    if err:
-        return [("bad_json", err)]
-    if bad:
-        f.append(("nonfinite_output", "stdout JSON has %s" % bad))
+    j, f = stdout_json(r)
+    if j is None:
+        return f
     st = j.get("status")
     if st != {0: "completed", 1: "failed"}.get(r.rc):
         f.append(("status_mismatch", "exit %d with status %r" % (r.rc, st)))
@@ -225,12 +227,9 @@ def check_sweep(r, d):
 
 
 def check_wet(r, d):
-    f = []
-    j, err, bad = parse_json(r.out)
-    if err:
-        return [("bad_json", err)]
-    if bad:
-        f.append(("nonfinite_output", "stdout JSON has %s" % bad))
+    j, f = stdout_json(r)
+    if j is None:
+        return f
     runs = j.get("runs") or []
     stable = [x.get("status") == "stable" for x in runs]
     good = bool(j.get("complete")) and len(runs) == len(BETAS) and all(stable)
