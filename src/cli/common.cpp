@@ -201,7 +201,16 @@ std::string json_text(const nlohmann::json& j, int indent) {
     return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
+nlohmann::json*& json_capture() {
+    static nlohmann::json* capture = nullptr;
+    return capture;
+}
+
 void emit_json(const nlohmann::json& j, const std::string& path) {
+    if (path.empty() && json_capture()) {
+        *json_capture() = j;
+        return;
+    }
     const std::string text = json_text(j, 2) + "\n";
     if (path.empty()) std::cout << text, flush_stdout();
     else write_file_atomic(path, text);
@@ -213,6 +222,11 @@ void flush_stdout() {
     if (!std::cout || std::fflush(stdout) != 0)
         throw OutputError(std::string("cannot write the results to standard output (") +
                           (errno ? std::strerror(errno) : "the write failed") + ")");
+}
+
+std::vector<std::string>& command_argv() {
+    static std::vector<std::string> argv;
+    return argv;
 }
 
 int& exit_code() {

@@ -74,8 +74,10 @@ nlohmann::json to_json(const ModelSummary& s);
 bool parse_decimal(const std::string& text, double& v);
 // JSON text (indent -1: one line); bytes that are not UTF-8 become U+FFFD instead of an exception.
 std::string json_text(const nlohmann::json& j, int indent = -1);
-// Prints JSON to stdout (or to `path` atomically when non-empty).
+// Prints JSON to stdout (or to `path` atomically when non-empty). While json_capture() points at a JSON value,
+// what would go to stdout is stored there instead (fibernet scan runs a command per sample in its own process).
 void emit_json(const nlohmann::json& j, const std::string& path = "");
+nlohmann::json*& json_capture();
 // Flushes standard output; OutputError (exit 4) when it cannot be written.
 void flush_stdout();
 // The bytes of a file a result depends on (a network file, a law table), e.g. for its fingerprint (util/hash.hpp);
@@ -83,6 +85,9 @@ void flush_stdout();
 std::string file_bytes(const std::string& path, const std::string& what);
 
 double seconds_since(const std::chrono::steady_clock::time_point& t0);
+
+// The command line as given (without the program name), set by main: recorded in results for provenance.
+std::vector<std::string>& command_argv();
 
 // Process exit code a command sets when its computation did not succeed (1); main returns it.
 int& exit_code();
@@ -99,5 +104,6 @@ void register_modulus(CLI::App& app);
 void register_relax(CLI::App& app);
 void register_wet(CLI::App& app);
 void register_sweep(CLI::App& app);
+void register_scan(CLI::App& app);
 
 }  // namespace fibernet::cli

@@ -12,7 +12,7 @@ int main(int argc, char** argv) {
     using namespace fibernet;
     CLI::App app{"fibernet: mechanics of random fiber networks by implicit energy minimization"};
     app.require_subcommand(1);
-    app.set_version_flag("--version", "fibernet 0.1.0");
+    app.set_version_flag("--version", std::string("fibernet ") + FIBERNET_VERSION + " (" + FIBERNET_GIT_COMMIT + ")");
     cli::register_generate(app);
     cli::register_export(app);
     cli::register_info(app);
@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
     cli::register_relax(app);
     cli::register_wet(app);
     cli::register_sweep(app);
+    cli::register_scan(app);
+    for (int i = 1; i < argc; ++i) cli::command_argv().push_back(argv[i]);
     try {
         (void)thread_count();  // a bad FIBERNET_THREADS is an input error before any work
         // CLI11 says only "A subcommand is required" for a word that names none: name it and the commands.

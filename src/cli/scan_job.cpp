@@ -1,0 +1,106 @@
+#include "scan_job.hpp"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <functional>
+#include <map>
+#include <set>
+
+#include "common.hpp"
+#include "fibernet/util/error.hpp"
+
+namespace fibernet::cli {
+
+namespace {
+const std::map<std::string, Registrar>& registrars() {
+    static const std::map<std::string, Registrar> r = {{"modulus", register_modulus}, {"relax", register_relax},
+                                                       {"rigidity", register_rigidity}, {"sweep", register_sweep},
+                                                       {"wet", register_wet}};
+    return r;
+}
+
+// Arguments a scan sets itself: the scene (its values come from the scene file and the grid) and the outputs.
+const std::set<std::string>& reserved() {
+    static const std::set<std::string> r = {
+        "--network", "--L", "--q", "--pl", "--seed", "--open", "--scheme", "--nseg", "--h", "--a", "--prune", "--gamma",
+        "--strain", "--solver", "--tol", "--max-iter", "--beta", "--law", "--crossings", "--fraction", "--wet-seed",
+        "--bundle-partners", "--free-box", "--free-box-shape", "--free-box-tol", "-o", "--out", "--out-dir",
+        "--output", "--svg", "--table", "--summary", "--checkpoint", "--resume", "-v", "--verbose", "-q", "--quiet"};
+    return r;
+}
+
+CLI::App* make_command(CLI::App& app, const std::string& job) {
+    const auto it = registrars().find(job);
+    if (it == registrars().end()) {
+        std::string names;
+        for (const auto& j : scan_jobs()) names += (names.empty() ? "" : ", ") + j;
+        throw InputError("command line: --job " + job + " is not a job a scan runs (expected one of: " + names + ")");
+    }
+    it->second(app);
+    return app.get_subcommand(job);
+}
+
+std::vector<std::string> argv_of(CLI::App* cmd, const std::string& job, const std::string& scene,
+                                 const std::vector<std::string>& args) {
+    std::vector<std::string> v = {job, scene};
+    if (cmd->get_option_no_throw("--quiet")) v.push_back("--quiet");
+    v.insert(v.end(), args.begin(), args.end());
+    return v;
+}
+
+void parse(CLI::App& app, std::vector<std::string> argv) {
+    std::reverse(argv.begin(), argv.end());  // CLI11 takes a reversed vector
+    app.parse(argv);
+}
+}  // namespace
+
+const std::vector<std::string>& scan_jobs() {
+    static const std::vector<std::string> j = {"modulus", "relax", "rigidity", "sweep", "wet"};
+    return j;
+}
+
+void check_job_args(const std::string& job, const std::vector<std::string>& args) {
+    for (const auto& a : args) {
+        const std::string flag = a.substr(0, a.find('='));
+        if (reserved().count(flag))
+            throw InputError("command line: --job-args " + a + ": a scan sets " + flag +
+                             " itself (scene values come from the scene and --vary; outputs go to -o)");
+    }
+    CLI::App app;
+    CLI::App* cmd = make_command(app, job);
+    cmd->callback([] {});  // parse only
+    std::vector<std::string> full = args;
+    if (job == "sweep") full.insert(full.end(), {"-o", "sweep.csv"});  // the scan gives each sample's CSV
+    try {
+        parse(app, argv_of(cmd, job, "/dev/null", full));  // a stand-in scene that exists
+    } catch (const CLI::ParseError& e) {
+        throw InputError("command line: --job-args for " + job + ": " + e.what());
+    }
+}
+
+JobOutcome run_job(const std::string& job, const std::string& scene_file, const std::vector<std::string>& args) {
+    CLI::App app;
+    CLI::App* cmd = make_command(app, job);
+    JobOutcome out;
+    json_capture() = &out.result;
+    exit_code() = 0;
+    struct Reset {
+        ~Reset() { json_capture() = nullptr; }
+    } reset;
+    try {
+        parse(app, argv_of(cmd, job, scene_file, args));
+        out.exit_code = exit_code();
+    } catch (const CLI::ParseError& e) {
+        throw InputError(std::string("the arguments of ") + job + ": " + e.what());
+    } catch (const InputError&) {
+        throw;
+    } catch (const OutputError&) {
+        throw;
+    } catch (const std::exception& e) {
+        out.exit_code = 3, out.error = e.what(), out.result = nullptr;
+    }
+    exit_code() = 0;
+    return out;
+}
+
+}  // namespace fibernet::cli

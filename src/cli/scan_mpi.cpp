@@ -1,0 +1,127 @@
+// The MPI transport of fibernet scan (scan_comm.hpp): compiled only with FIBERNET_MPI (CMakeLists.txt).
+#ifdef FIBERNET_WITH_MPI
+#include <mpi.h>
+
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "scan_comm.hpp"
+
+namespace fibernet::cli {
+
+bool built_with_mpi() { return true; }
+
+namespace {
+constexpr int kRequest = 1, kReply = 2;
+
+nlohmann::json report_json(std::size_t index, const SampleReport& r) {
+    return {{"index", index}, {"ok", r.ok}, {"seconds", r.seconds}, {"interrupted", r.interrupted},
+            {"input_error", r.input_error}, {"output_error", r.output_error}};
+}
+SampleReport report_of(const nlohmann::json& j) {
+    SampleReport r;
+    r.ok = j.value("ok", false), r.seconds = j.value("seconds", 0.0), r.interrupted = j.value("interrupted", false);
+    r.input_error = j.value("input_error", std::string()), r.output_error = j.value("output_error", std::string());
+    return r;
+}
+
+class MpiComm : public ScanComm {
+public:
+    MpiComm() {
+        int provided = 0;
+        MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+        threaded_ = provided >= MPI_THREAD_FUNNELED;
+        // PMPI_: Debian's sequential MUMPS (linked by Ipopt) exports stand-ins for MPI_Init, MPI_Comm_rank,
+        // MPI_Finalize and MPI_Wtime that return rank 0 and do nothing; the profiling names reach Open MPI's own.
+        PMPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+        MPI_Comm_size(MPI_COMM_WORLD, &size_);
+    }
+    ~MpiComm() override { PMPI_Finalize(); }
+    int rank() const override { return rank_; }
+    int size() const override { return size_; }
+    std::string kind() const override { return "mpi"; }
+
+    std::string share(const std::string& m) override {
+        long long n = static_cast<long long>(m.size());
+        MPI_Bcast(&n, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+        std::string s = rank_ == 0 ? m : std::string(static_cast<std::size_t>(n), '\0');
+        if (n > 0) MPI_Bcast(s.data(), static_cast<int>(n), MPI_CHAR, 0, MPI_COMM_WORLD);
+        return s;
+    }
+    void barrier() override { MPI_Barrier(MPI_COMM_WORLD); }
+
+    DispatchOutcome run(SampleQueue* queue, const SampleRunner& runner) override {
+        return rank_ == 0 ? schedule(*queue, runner) : work(runner);
+    }
+
+private:
+    // Ranks > 0: ask for a sample with the report of the last one, run it, until told -1.
+    DispatchOutcome work(const SampleRunner& runner) {
+        std::string msg = "{}";
+        for (;;) {
+            MPI_Send(msg.data(), static_cast<int>(msg.size()), MPI_CHAR, 0, kRequest, MPI_COMM_WORLD);
+            long long index = -1;
+            MPI_Recv(&index, 1, MPI_LONG_LONG, 0, kReply, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+            if (index < 0) return {};
+            const auto i = static_cast<std::size_t>(index);
+            msg = report_json(i, runner(i)).dump();
+        }
+    }
+
+    // Rank 0: a worker thread of its own takes from the queue while this thread answers the other ranks. The
+    // probe polls (with a 1 ms sleep) rather than blocking: a blocking receive spins a core in Open MPI.
+    DispatchOutcome schedule(SampleQueue& queue, const SampleRunner& runner) {
+        DispatchOutcome out;
+        std::mutex mu;
+        std::thread local;
+        if (threaded_)
+            local = std::thread([&] {
+                while (auto i = queue.next()) {
+                    const SampleReport r = runner(*i);
+                    std::lock_guard<std::mutex> lock(mu);
+                    if (take_report(queue, *i, r, out)) break;
+                }
+            });
+        int active = size_ - 1;
+        while (active > 0) {
+            int flag = 0;
+            MPI_Status st;
+            MPI_Iprobe(MPI_ANY_SOURCE, kRequest, MPI_COMM_WORLD, &flag, &st);
+            if (!flag) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(1));
+                continue;
+            }
+            int n = 0;
+            MPI_Get_count(&st, MPI_CHAR, &n);
+            std::string text(static_cast<std::size_t>(n), '\0');
+            MPI_Recv(text.data(), n, MPI_CHAR, st.MPI_SOURCE, kRequest, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+            const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+            if (j.is_object() && j.contains("index")) {
+                std::lock_guard<std::mutex> lock(mu);
+                take_report(queue, j["index"].get<std::size_t>(), report_of(j), out);
+            }
+            const auto next = queue.next();
+            const long long index = next ? static_cast<long long>(*next) : -1;
+            MPI_Send(&index, 1, MPI_LONG_LONG, st.MPI_SOURCE, kReply, MPI_COMM_WORLD);
+            if (index < 0) --active;
+        }
+        if (local.joinable()) local.join();
+        if (!threaded_) {  // no second thread: rank 0 runs what is left once the others are done
+            while (auto i = queue.next())
+                if (take_report(queue, *i, runner(*i), out)) break;
+        }
+        return out;
+    }
+
+    int rank_ = 0, size_ = 1;
+    bool threaded_ = false;
+};
+}  // namespace
+
+std::unique_ptr<ScanComm> mpi_scan_comm() { return std::make_unique<MpiComm>(); }
+
+}  // namespace fibernet::cli
+#endif
