@@ -3,7 +3,9 @@
 #include <charconv>
 #include <cstdio>
 #include <cmath>
+#include <cstdint>
 #include <functional>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -102,6 +104,10 @@ const std::vector<std::string>& scene_keys() {
 }
 
 std::string to_toml(const Scene& s, const std::map<std::string, std::string>& replace) {
+    for (const auto& [name, seed] : {std::pair<const char*, std::uint64_t>{"network.seed", s.mikado.seed}, {"wet.seed", s.wet.seed}})
+        if (seed > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()) && !replace.count(name))
+            throw InputError(std::string(name) + " = " + std::to_string(seed) + " cannot be written in a TOML scene "
+                             "(TOML integers stop at 2^63 - 1 = 9223372036854775807): give a smaller seed");
     const std::set<std::string> known(scene_keys().begin(), scene_keys().end());
     for (const auto& [key, value] : replace)
         if (!known.count(key)) throw InputError("scene key '" + key + "' is unknown");

@@ -1,0 +1,175 @@
+// `fibernet scan` end to end (serial; the MPI runs are tests/cli/scan_mpi_test.sh): rows and summary, shards and
+// their merge, resume after SIGINT and SIGKILL, a failed sample as a row, a sample's scene rerun by hand, bad input.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "../support/cli_run.hpp"
+
+using namespace clitest;
+
+namespace {
+// 18 samples of about 0.1 s each: moduli of L = 4 networks over q and three seeds.
+const std::string kGrid = "--L 4 --scheme even --prune dangling --vary q=6,8,12 --vary a=10,100 --vary seed=1:3 "
+                          "--job modulus -q";
+
+std::string dir(const std::string& name) {
+    const std::string d = tmpdir() + "/" + name;
+    std::filesystem::remove_all(d);
+    return d;
+}
+
+std::vector<std::string> lines(const std::string& text) {
+    std::vector<std::string> v;
+    std::istringstream is(text);
+    for (std::string l; std::getline(is, l);) v.push_back(l);
+    return v;
+}
+
+// The reference: the whole grid in one serial run.
+const std::string& reference() {
+    static const std::string d = [] {
+        const std::string r = dir("reference");
+        REQUIRE(run("scan " + kGrid + " -o " + r) == 0);
+        return r;
+    }();
+    return d;
+}
+
+int journal_records(const std::string& d) {
+    int n = 0;
+    for (const auto& e : std::filesystem::directory_iterator(d + "/journal")) n += static_cast<int>(lines(slurp(e.path())).size());
+    return n;
+}
+}  // namespace
+
+TEST_CASE("cli scan: one row per sample in index order, a summary row per grid point", "[cli][scan]") {
+    const std::string r = reference();
+    const auto rows = lines(slurp(r + "/samples.csv"));
+    REQUIRE(rows.size() == 19);
+    CHECK(rows[0].rfind("index,q,a,seed,status,exit_code,", 0) == 0);
+    CHECK(rows[0].find(",moduli.G,") != std::string::npos);
+    CHECK(rows[0].find("seconds") == std::string::npos);  // timings stay in samples.jsonl
+    for (int i = 0; i < 18; ++i) CHECK(rows[i + 1].rfind(std::to_string(i) + ",", 0) == 0);
+    CHECK(rows[5].rfind("4,6,100,2,converged,0,", 0) == 0);  // index 4: q = 6, a = 100, seed = 2
+    const auto summary = lines(slurp(r + "/summary.csv"));
+    REQUIRE(summary.size() == 7);  // 3 q x 2 a
+    CHECK(summary[0].rfind("q,a,samples,ok,", 0) == 0);
+    CHECK(summary[0].find("moduli.G_ratio.mean,moduli.G_ratio.sem") != std::string::npos);
+    CHECK(summary[6].rfind("12,100,3,3,", 0) == 0);
+    const auto out = nlohmann::json::parse(slurp(tmpdir() + "/stdout"));
+    (void)out;
+    const auto m = nlohmann::json::parse(slurp(r + "/scan.json"));
+    CHECK(m["samples"] == 18);
+    CHECK(m["job"] == "modulus");
+    CHECK(m["command"].get<std::string>().find("--vary q=6,8,12") != std::string::npos);
+    CHECK(lines(slurp(r + "/samples.jsonl")).size() == 18);
+}
+
+TEST_CASE("cli scan: shards run apart and merged give the rows of one run, bit for bit", "[cli][scan]") {
+    const std::string ref = slurp(reference() + "/samples.csv");
+    const std::string a = dir("shard_a"), b = dir("shard_b"), merged = dir("merged"), same = dir("shared");
+    REQUIRE(run("scan " + kGrid + " --shard 0/2 -o " + a) == 0);
+    REQUIRE(run("scan " + kGrid + " --shard 1/2 -o " + b) == 0);
+    CHECK(lines(slurp(a + "/samples.csv")).size() == 10);  // its 9 samples
+    REQUIRE(run("scan --merge " + a + " " + b + " -o " + merged) == 0);
+    CHECK(slurp(merged + "/samples.csv") == ref);
+    CHECK(slurp(merged + "/summary.csv") == slurp(reference() + "/summary.csv"));
+    CHECK(nlohmann::json::parse(slurp(tmpdir() + "/stdout"))["complete"] == true);
+    // Merging again adds nothing; shards of one directory need no merge.
+    REQUIRE(run("scan --merge " + a + " " + b + " -o " + merged) == 0);
+    CHECK(slurp(merged + "/samples.csv") == ref);
+    REQUIRE(run("scan " + kGrid + " --shard 1/2 -o " + same) == 0);
+    REQUIRE(run("scan " + kGrid + " --shard 0/2 -o " + same) == 0);
+    CHECK(slurp(same + "/samples.csv") == ref);
+    // Another scan's directory is refused.
+    CHECK(run("scan " + kGrid + " --vary gamma=0.01 --shard 0/2 -o " + a) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("holds another scan") != std::string::npos);
+}
+
+TEST_CASE("cli scan: interrupted (SIGINT) or killed (SIGKILL), it resumes without losing a finished sample", "[cli][scan][signal]") {
+    const std::string ref = slurp(reference() + "/samples.csv");
+    for (const std::string sig : {"INT", "KILL"}) {
+        INFO(sig);
+        const std::string d = dir("resume_" + sig);
+        // Stop it once two samples are journaled (set -m: a background job of a script would ignore SIGINT).
+        const std::string script = "set -m; " + std::string(FIBERNET_EXE) + " scan " + kGrid + " -o " + d + " >/dev/null 2>" + d +
+                                   ".err & pid=$!; for i in $(seq 1 600); do n=$(cat " + d + "/journal/*.jsonl 2>/dev/null | wc -l); " +
+                                   "[ \"$n\" -ge 2 ] && break; sleep 0.01; done; kill -" + sig + " $pid; wait $pid; echo $? > " + d + ".rc";
+        REQUIRE(std::system(("bash -c '" + script + "'").c_str()) >= 0);
+        const int rc = std::stoi(slurp(d + ".rc"));
+        CHECK(rc == (sig == "INT" ? 130 : 137));
+        const int kept = journal_records(d);
+        CHECK(kept >= 2);
+        CHECK(kept < 18);
+        if (sig == "INT") CHECK(slurp(d + ".err").find("--resume") != std::string::npos);
+        CHECK(run("scan " + kGrid + " -o " + d) == 2);  // a rerun without --resume is refused, naming it
+        CHECK(slurp(tmpdir() + "/stderr").find("add --resume") != std::string::npos);
+        REQUIRE(run("scan " + kGrid + " --resume -o " + d) == 0);
+        CHECK(slurp(d + "/samples.csv") == ref);
+        const auto out = nlohmann::json::parse(slurp(tmpdir() + "/stdout"));
+        CHECK(out["run"]["samples_run"].get<int>() == 18 - kept);
+    }
+}
+
+TEST_CASE("cli scan: a sample whose solver fails is a row with its status, and the exit code says so", "[cli][scan]") {
+    const std::string d = dir("failing");
+    // A strained solve with a budget of one Newton iteration fails at the larger strain only.
+    CHECK(run("scan --L 4 --scheme even --max-iter 1 --vary gamma=0,0.05 --job relax -q -o " + d) == 1);
+    const auto rows = lines(slurp(d + "/samples.csv"));
+    REQUIRE(rows.size() == 3);
+    CHECK(rows[1].rfind("0,0,converged,0,", 0) == 0);
+    CHECK(rows[2].find(",converged,") == std::string::npos);
+    CHECK(rows[2].find(",1,") != std::string::npos);
+    const auto out = nlohmann::json::parse(slurp(tmpdir() + "/stdout"));
+    CHECK(out["failed"] == 1);
+    CHECK(out["complete"] == true);
+}
+
+TEST_CASE("cli scan: a sample's scene, printed, reruns to the same result", "[cli][scan]") {
+    const std::string r = reference();
+    REQUIRE(run("scan -o " + r + " --print-scene 13") == 0);  // q = 12, a = 10, seed = 2
+    const std::string scene = tmpdir() + "/sample13.toml";
+    write(scene, slurp(tmpdir() + "/stdout"));
+    CHECK(slurp(scene).find("q = 12") != std::string::npos);
+    // The scan runs a sample on one thread; so does this run.
+    const std::string cmd = "FIBERNET_THREADS=1 OPENBLAS_NUM_THREADS=1 " + std::string(FIBERNET_EXE) + " modulus " +
+                            scene + " -q > " + tmpdir() + "/direct.json";
+    REQUIRE(std::system(cmd.c_str()) == 0);
+    const auto direct = nlohmann::json::parse(slurp(tmpdir() + "/direct.json"));
+    std::string record;
+    for (const auto& l : lines(slurp(r + "/samples.jsonl")))
+        if (l.rfind("{\"exit_code\":0,\"host\"", 0) == 0 && l.find("\"index\":13,") != std::string::npos) record = l;
+    REQUIRE(!record.empty());
+    const auto rec = nlohmann::json::parse(record);
+    CHECK(rec["params"]["q"] == "12");
+    CHECK(rec["result"]["moduli"]["G"] == direct["moduli"]["G"]);
+    CHECK(rec["result"]["energy"] == direct["energy"]);
+    CHECK(run("scan -o " + r + " --print-scene 18") == 2);
+}
+
+TEST_CASE("cli scan: bad grids, jobs and arguments exit 2 before any work and leave no directory", "[cli][scan][input]") {
+    const std::string d = dir("bad");
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"--vary q=4,-1 --job modulus", "q = -1)"},
+        {"--vary density=1,2 --job modulus", "'density' is not a scene key"},
+        {"--vary q=4,,8 --job modulus", "an empty value"},
+        {"--vary seed=3:1 --job modulus", "last 1 is below first 3"},
+        {"--vary scheme=even,odd --job modulus", "odd"},
+        {"--vary q=4 --job generate", "--job generate is not a job"},
+        {"--vary q=4", "--job is required"},
+        {"--vary q=4 --job modulus --job-args \"--q 3\"", "a scan sets --q itself"},
+        {"--vary q=4 --job modulus --job-args --bogus", "--job-args for modulus"},
+        {"--vary q=4 --job modulus --shard 2/2", "need 0 <= i < N"},
+        {"--vary q=4 --job modulus --shard x", "is not i/N"},
+        {"--vary q=4 --vary network.q=5 --job modulus", "varied twice"},
+    };
+    for (const auto& [args, says] : cases) {
+        INFO(args);
+        CHECK(run("scan --L 3 " + args + " -o " + d) == 2);
+        CHECK(slurp(tmpdir() + "/stderr").find(says) != std::string::npos);
+        CHECK(!std::filesystem::exists(d));
+    }
+}
