@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 pkgs=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libopenblas-dev
       libnlopt-cxx-dev coinor-libipopt-dev catch2 libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
-      python3-matplotlib)  # python3-matplotlib: bench/plot_percolation.py
+      openmpi-bin libopenmpi-dev python3-matplotlib)  # MPI: fibernet scan; matplotlib: the plot scripts
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
