@@ -7,6 +7,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <thread>
+#include <vector>
 
 #include "scan_comm.hpp"
 
@@ -58,16 +59,25 @@ public:
     }
 
 private:
-    // Ranks > 0: ask for a sample with the report of the last one, run it, until told -1.
+    // Ranks > 0: ask for samples with the reports of the last ones, run them, until told none are left.
     DispatchOutcome work(const SampleRunner& runner) {
-        std::string msg = "{}";
+        nlohmann::json reports = nlohmann::json::array();
         for (;;) {
+            const std::string msg = reports.dump();
             MPI_Send(msg.data(), static_cast<int>(msg.size()), MPI_CHAR, 0, kRequest, MPI_COMM_WORLD);
-            long long index = -1;
-            MPI_Recv(&index, 1, MPI_LONG_LONG, 0, kReply, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-            if (index < 0) return {};
-            const auto i = static_cast<std::size_t>(index);
-            msg = report_json(i, runner(i)).dump();
+            MPI_Status st;
+            MPI_Probe(0, kReply, MPI_COMM_WORLD, &st);
+            int n = 0;
+            MPI_Get_count(&st, MPI_LONG_LONG, &n);
+            std::vector<long long> batch(static_cast<std::size_t>(n));
+            MPI_Recv(batch.data(), n, MPI_LONG_LONG, 0, kReply, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+            if (batch.empty()) return {};
+            reports = nlohmann::json::array();
+            for (long long index : batch) {
+                const SampleReport r = runner(static_cast<std::size_t>(index));
+                reports.push_back(report_json(static_cast<std::size_t>(index), r));
+                if (r.interrupted || !r.input_error.empty() || !r.output_error.empty()) break;  // the rest stay unrun
+            }
         }
     }
 
@@ -98,15 +108,17 @@ private:
             MPI_Get_count(&st, MPI_CHAR, &n);
             std::string text(static_cast<std::size_t>(n), '\0');
             MPI_Recv(text.data(), n, MPI_CHAR, st.MPI_SOURCE, kRequest, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-            const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-            if (j.is_object() && j.contains("index")) {
+            const nlohmann::json reports = nlohmann::json::parse(text, nullptr, false);
+            if (reports.is_array()) {
                 std::lock_guard<std::mutex> lock(mu);
-                take_report(queue, j["index"].get<std::size_t>(), report_of(j), out);
+                for (const auto& j : reports) take_report(queue, j.at("index").get<std::size_t>(), report_of(j), out);
             }
-            const auto next = queue.next();
-            const long long index = next ? static_cast<long long>(*next) : -1;
-            MPI_Send(&index, 1, MPI_LONG_LONG, st.MPI_SOURCE, kReply, MPI_COMM_WORLD);
-            if (index < 0) --active;
+            // Batches of about 50 ms of samples: a request's round trip (up to the 1 ms poll) is then small beside
+            // the work it brings, while samples of a second or more still go one at a time.
+            std::vector<long long> batch;
+            for (std::size_t i : queue.next_batch(256, 0.05, size_)) batch.push_back(static_cast<long long>(i));
+            MPI_Send(batch.data(), static_cast<int>(batch.size()), MPI_LONG_LONG, st.MPI_SOURCE, kReply, MPI_COMM_WORLD);
+            if (batch.empty()) --active;
         }
         if (local.joinable()) local.join();
         if (!threaded_) {  // no second thread: rank 0 runs what is left once the others are done

@@ -1,5 +1,6 @@
 #include "fibernet/ensemble/sample_queue.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -23,6 +24,21 @@ std::optional<std::size_t> SampleQueue::next() {
     std::lock_guard<std::mutex> lock(mu_);
     if (stopped_ || next_ >= todo_.size()) return std::nullopt;
     return todo_[next_++];
+}
+
+std::vector<std::size_t> SampleQueue::next_batch(std::size_t max, double target_seconds, int workers) {
+    std::lock_guard<std::mutex> lock(mu_);
+    std::vector<std::size_t> out;
+    if (stopped_ || next_ >= todo_.size()) return out;
+    const std::size_t left = todo_.size() - next_;
+    std::size_t n = 1;
+    if (done_ > 0 && busy_ > 0) {
+        const double mean = busy_ / static_cast<double>(done_);
+        n = static_cast<std::size_t>(std::max(1.0, std::min(static_cast<double>(max), target_seconds / mean)));
+    }
+    n = std::min(n, std::max<std::size_t>(1, left / (4 * static_cast<std::size_t>(std::max(1, workers)))));
+    for (std::size_t k = 0; k < n; ++k) out.push_back(todo_[next_++]);
+    return out;
 }
 
 void SampleQueue::finished(std::size_t, bool ok, double seconds) {

@@ -16,6 +16,10 @@ public:
     // todo: the indices to run, in order; progress lines go to stderr every `report_seconds` (none if < 0).
     SampleQueue(std::vector<std::size_t> todo, double report_seconds);
     std::optional<std::size_t> next();  // nullopt once every sample is handed out, or after stop()
+    // Up to `max` samples for a worker that asks over a network: as many as take about `target_seconds` at the mean
+    // sample time so far (one while nothing has finished), but at most a quarter of what is left per worker, so
+    // that the last samples still spread over the workers. Empty once every sample is handed out, or after stop().
+    std::vector<std::size_t> next_batch(std::size_t max, double target_seconds, int workers);
     void finished(std::size_t index, bool ok, double seconds);
     void stop();                        // hand out no more samples (an interrupt, an input error)
     bool stopped() const;
