@@ -16,6 +16,7 @@
 #include <iostream>
 #include <charconv>
 #include <map>
+#include <memory>
 #include <optional>
 #include <mutex>
 #include <set>
@@ -25,6 +26,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "scan_comm.hpp"
 #include "fibernet/util/error.hpp"
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/rigidity/percolation.hpp"
@@ -163,20 +165,230 @@ WidthScalingFit width_fit_without(std::vector<double> L, std::vector<double> w, 
     }
     return fit_width_scaling(L, w, e);
 }
+struct PercolationOpts {
+    double pl = 1, q_min = 0, q_max = 0, q_step = 0;
+    std::vector<double> L;
+    int samples = 0, threads = 2;
+    std::uint64_t seed = 1;
+    std::string out, table, summary;
+    bool resume = false, quiet = false;
+};
+
+struct Item {
+    double L, q;
+    int sample;
+};
+
+void check_opts(const PercolationOpts& o) {
+    const std::string w = "command line";
+    check_value(o.pl > 0 && o.pl <= 1, o.pl, w, "--pl", "must lie in (0, 1]");
+    for (double L : o.L) check_value(L > 0 && L <= 2000, L, w, "--L", "must lie in (0, 2000]");
+    check_value(o.q_min > 0, o.q_min, w, "--q-min", "must be > 0");
+    check_value(o.q_max >= o.q_min, o.q_max, w, "--q-max", "must be >= --q-min");
+    check_value(o.q_step > 0, o.q_step, w, "--q-step", "must be > 0");
+    check_value((o.q_max - o.q_min) / o.q_step <= 10000, o.q_step, w, "--q-step", "gives more than 10000 densities");
+    check_value(o.samples >= 1 && o.samples <= 1000000, o.samples, w, "--samples", "must lie in [1, 1e6]");
+    check_value(o.threads >= 1 && o.threads <= 256, o.threads, w, "--threads", "must lie in [1, 256]");
+    check_outputs({{"--out", o.out}, {"--table", o.table}, {"--summary", o.summary}});
+}
+
+int density_count(const PercolationOpts& o) {
+    return static_cast<int>(std::floor((o.q_max - o.q_min) / o.q_step + 1e-9)) + 1;
+}
+double density_at(const PercolationOpts& o, int k) { return std::round((o.q_min + k * o.q_step) * 1e9) / 1e9; }
+
+// Every sample of the run, L-major: a sample's index into this list is what the ranks pass around.
+std::vector<Item> grid_items(const PercolationOpts& o) {
+    std::vector<Item> items;
+    for (double L : o.L)
+        for (int k = 0; k < density_count(o); ++k)
+            for (int s = 0; s < o.samples; ++s) items.push_back({L, density_at(o, k), s});
+    return items;
+}
+
+// Rank 0: the rows of an existing CSV (--resume) and the samples it lacks. This run's (L, q) values by their CSV
+// text: a row's seed is checked against the exact values where the 10 digits written lost some.
+std::vector<PercolationSample> existing_rows(const PercolationOpts& o, bool& newline) {
+    std::map<std::pair<std::string, std::string>, std::pair<double, double>> grid;
+    for (double L : o.L)
+        for (int k = 0; k < density_count(o); ++k) grid[{fmt(L), fmt(density_at(o, k))}] = {L, density_at(o, k)};
+    auto short_text = [](double v) {  // fewer than 10 significant digits in the CSV: parsed back exactly
+        int digits = 0;
+        bool leading = true;
+        for (char ch : fmt(v)) {
+            if (ch == 'e' || ch == 'E') break;
+            if (ch < '0' || ch > '9') continue;
+            if (leading && ch == '0') continue;
+            leading = false, ++digits;
+        }
+        return digits < 10;
+    };
+    auto seed_of = [&](const PercolationSample& r) -> std::optional<std::uint64_t> {
+        auto it = grid.find({fmt(r.L), fmt(r.q)});
+        if (it != grid.end()) return percolation_seed(o.seed, it->second.first, it->second.second, r.sample);
+        if (short_text(r.L) && short_text(r.q)) return percolation_seed(o.seed, r.L, r.q, r.sample);
+        return std::nullopt;
+    };
+    newline = true;
+    std::ifstream probe(o.out);
+    if (!probe.good()) return {};
+    if (!o.resume) throw InputError("command line: --out " + o.out + " exists; add --resume to continue it");
+    return read_rows(o.out, o.pl, o.seed, seed_of, newline);
+}
+
+// Rank 0's CSV: the header on a new file, then one row per finished sample as it arrives.
+struct SampleCsv {
+    std::ofstream csv;
+    std::size_t written = 0;
+    SampleCsv(const std::string& path, bool new_file, bool newline) : csv(path, std::ios::app) {
+        if (!csv) throw InputError("command line: cannot open --out " + path + " for writing");
+        if (new_file) {
+            std::ifstream probe(path);
+            if (probe.peek() == std::ifstream::traits_type::eof()) csv << kHeader << '\n';
+        }
+        if (!newline) csv << '\n';
+        csv.flush();
+    }
+};
+
+// Rank 0: prepares the CSV and lists the samples to run; the message (empty: go on) reaches every rank.
+std::string prepare(const PercolationOpts& o, const std::vector<Item>& items, std::vector<PercolationSample>& rows,
+                    std::vector<std::size_t>& todo, std::unique_ptr<SampleCsv>& csv) {
+    try {
+        bool newline = true;
+        rows = existing_rows(o, newline);
+        std::set<Key> done;
+        for (const auto& r : rows) done.insert({fmt(r.L), fmt(r.q), r.sample});
+        for (std::size_t i = 0; i < items.size(); ++i)
+            if (!done.count({fmt(items[i].L), fmt(items[i].q), items[i].sample})) todo.push_back(i);
+        if (!todo.empty()) csv = std::make_unique<SampleCsv>(o.out, rows.empty(), newline);
+        return "";
+    } catch (const InputError& e) {
+        return e.what();
+    }
+}
+
+// P(q) per L from every row (earlier runs with other q ranges included), the fits, the JSON summary.
+void summarize(const PercolationOpts& opts, const std::vector<PercolationSample>& rows) {
+    const PercolationOpts* o = &opts;
+    // P(q) per L from every row in the CSV (earlier runs with other q ranges included).
+    std::map<double, std::map<double, std::array<int, 3>>> counts;  // L -> q -> {n, rigid, connected}
+    for (const auto& r : rows) {
+        auto& c = counts[r.L][r.q];
+        c[0] += 1, c[1] += r.rigid, c[2] += r.connected;
+    }
+    std::ostringstream table;
+    table << "pl,L,q,samples,P_rigid,P_connected\n";
+    nlohmann::json per_L = nlohmann::json::array();
+    std::vector<double> Lr, yr, er, wr, wer, Lc, yc, ec, wc, wec;  // sizes with a probit fit: q_1/2, width
+    for (const auto& [L, byq] : counts) {
+        std::vector<double> qs;
+        std::vector<int> n, hr, hc;
+        for (const auto& [q, c] : byq) {
+            qs.push_back(q), n.push_back(c[0]), hr.push_back(c[1]), hc.push_back(c[2]);
+            table << fmt(o->pl) << ',' << fmt(L) << ',' << fmt(q) << ',' << c[0] << ',' << fmt(double(c[1]) / c[0]) << ','
+                  << fmt(double(c[2]) / c[0]) << '\n';
+        }
+        const ProbitFit fr = fit_spanning_probability(qs, hr, n), fc = fit_spanning_probability(qs, hc, n);
+        if (fr.ok)
+            Lr.push_back(L), yr.push_back(fr.q_half), er.push_back(fr.q_half_err), wr.push_back(fr.width),
+                wer.push_back(fr.width_err);
+        if (fc.ok)
+            Lc.push_back(L), yc.push_back(fc.q_half), ec.push_back(fc.q_half_err), wc.push_back(fc.width),
+                wec.push_back(fc.width_err);
+        long samples = 0;
+        for (int k : n) samples += k;
+        per_L.push_back({{"L", L}, {"samples", samples}, {"densities", qs.size()}, {"rigid", fit_json(fr)},
+                         {"connected", fit_json(fc)}});
+    }
+    if (!o->table.empty()) write_file_atomic(o->table, table.str());
+    // nu from the probit widths, width(L) = c L^(-1/nu), then q_c with nu held there (docs/rigidity.md).
+    const WidthScalingFit width_r = fit_width_scaling(Lr, wr, wer), width_c = fit_width_scaling(Lc, wc, wec);
+    double cpu = 0;
+    for (const auto& r : rows) cpu += r.seconds;
+    emit_json({{"pl", o->pl},
+               {"csv", o->out},
+               {"rows", rows.size()},
+               {"sample_seconds_total", cpu},
+               {"per_L", per_L},
+               {"scaling",
+                {{"model", "q_half(L) = q_c + A L^(-1/nu)"},
+                 {"rigid", fit_json(fit_finite_size_scaling(Lr, yr, er))},
+                 {"connected", fit_json(fit_finite_size_scaling(Lc, yc, ec))},
+                 // Known exponents: 2D rigidity percolation nu = 1.21 (Jacobs & Thorpe 1995, bond-diluted
+                 // triangular lattice), 2D connectivity percolation nu = 4/3 (exact).
+                 {"rigid_nu_1.21", fit_json(fit_finite_size_scaling_fixed_nu(Lr, yr, er, 1.21))},
+                 {"connected_nu_4/3", fit_json(fit_finite_size_scaling_fixed_nu(Lc, yc, ec, 4.0 / 3.0))},
+                 {"width_model", "width(L) = c L^(-1/nu)"},
+                 {"rigid_width", fit_json(width_r)},
+                 {"connected_width", fit_json(width_c)},
+                 {"rigid_width_without_smallest_L", fit_json(width_fit_without(Lr, wr, wer, false))},
+                 {"connected_width_without_smallest_L", fit_json(width_fit_without(Lc, wc, wec, false))},
+                 {"rigid_width_without_largest_L", fit_json(width_fit_without(Lr, wr, wer, true))},
+                 {"connected_width_without_largest_L", fit_json(width_fit_without(Lc, wc, wec, true))},
+                 {"rigid_nu_from_width", width_nu_json(fit_finite_size_scaling_width_nu(Lr, yr, er, width_r))},
+                 {"connected_nu_from_width",
+                  width_nu_json(fit_finite_size_scaling_width_nu(Lc, yc, ec, width_c))}}}},
+              o->summary);
+}
+
+// The samples on this process's threads and, under mpirun, on every rank (scan_comm.hpp); rank 0 writes each
+// finished sample's row to the CSV at once.
+void run_percolation(const PercolationOpts& o) {
+    check_opts(o);
+    const std::vector<Item> items = grid_items(o);
+    auto comm = start_scan_comm();
+    std::vector<PercolationSample> rows;
+    std::vector<std::size_t> todo;
+    std::unique_ptr<SampleCsv> csv;
+    const std::string verdict = comm->share(comm->rank() == 0 ? prepare(o, items, rows, todo, csv) : "");
+    if (!verdict.empty()) {
+        end_if_not_root(comm, 2);
+        throw InputError(verdict);
+    }
+    SampleQueue queue(std::move(todo), o.quiet ? -1.0 : 2.0, "percolation pl=" + fmt(o.pl));
+    const std::size_t before = rows.size();
+    bool write_failed = false;
+    const DispatchOutcome out = comm->run(
+        comm->rank() == 0 ? &queue : nullptr,
+        [&](std::size_t i) {
+            const PercolationSample s = percolation_sample(o.pl, items[i].L, items[i].q, items[i].sample, o.seed);
+            SampleReport r;
+            r.seconds = s.seconds, r.payload = csv_line(s);
+            return r;
+        },
+        comm->size() > 1 ? 1 : o.threads,
+        [&](std::size_t i, const SampleReport& r) {
+            PercolationSample s;
+            std::uint64_t seed = 0;
+            int rigid = 0, conn = 0;
+            std::string line = r.payload;
+            if (!line.empty() && line.back() == '\n') line.pop_back();
+            if (write_failed || !parse_row(line, s, seed, rigid, conn)) return;
+            csv->csv << r.payload << std::flush;
+            if (!csv->csv) {  // a full device: stop taking samples; reported after the pool
+                write_failed = true;
+                queue.stop();
+                return;
+            }
+            s.L = items[i].L, s.q = items[i].q, s.seed = seed, s.rigid = rigid, s.connected = conn;  // exact L, q
+            rows.push_back(s);
+        });
+    (void)out;
+    comm->barrier();
+    end_if_not_root(comm, 0);
+    if (write_failed)
+        throw OutputError("cannot append samples to --out '" + o.out + "' (" + std::to_string(rows.size() - before) +
+                          " written; --resume continues)");
+    summarize(o, rows);
+}
 }  // namespace
 
 void register_percolation(CLI::App& app) {
     auto* cmd = app.add_subcommand("percolation", "rigidity and connectivity percolation: P(q) per L (CSV), q_1/2(L) "
-                                                  "and the finite-size scaling fit q_c, nu (JSON)");
-    struct Opts {
-        double pl = 1, q_min = 0, q_max = 0, q_step = 0;
-        std::vector<double> L;
-        int samples = 0, threads = 2;
-        std::uint64_t seed = 1;
-        std::string out, table, summary;
-        bool resume = false;
-    };
-    auto o = std::make_shared<Opts>();
+                                                  "and the finite-size scaling fit q_c, nu (JSON); mpirun -n K runs "
+                                                  "its samples on K ranks");
+    auto o = std::make_shared<PercolationOpts>();
     cmd->add_option("--pl", o->pl, "crosslink probability")->required();
     cmd->add_option("--L", o->L, "box sizes in fiber lengths (list)")->required()->delimiter(',');
     cmd->add_option("--q-min", o->q_min, "first density")->required();
@@ -184,167 +396,13 @@ void register_percolation(CLI::App& app) {
     cmd->add_option("--q-step", o->q_step, "density step")->required();
     cmd->add_option("--samples", o->samples, "networks per (L, q)")->required();
     cmd->add_option("--seed", o->seed, "base seed, an integer in [0, 2^64) (default 1)")->check(seed_check());
-    cmd->add_option("--threads", o->threads, "worker threads (default 2)");
+    cmd->add_option("--threads", o->threads, "worker threads (default 2; one per rank under mpirun)");
     cmd->add_option("--out", o->out, "CSV of samples, appended per sample")->required();
     cmd->add_flag("--resume", o->resume, "continue an existing CSV: run only the samples it lacks");
     cmd->add_option("--table", o->table, "also write P(q) per L as CSV here");
     cmd->add_option("--summary", o->summary, "write the JSON summary here instead of stdout");
-    cmd->callback([o] {
-        const std::string w = "command line";
-        check_value(o->pl > 0 && o->pl <= 1, o->pl, w, "--pl", "must lie in (0, 1]");
-        for (double L : o->L) check_value(L > 0 && L <= 2000, L, w, "--L", "must lie in (0, 2000]");
-        check_value(o->q_min > 0, o->q_min, w, "--q-min", "must be > 0");
-        check_value(o->q_max >= o->q_min, o->q_max, w, "--q-max", "must be >= --q-min");
-        check_value(o->q_step > 0, o->q_step, w, "--q-step", "must be > 0");
-        check_value((o->q_max - o->q_min) / o->q_step <= 10000, o->q_step, w, "--q-step", "gives more than 10000 densities");
-        check_value(o->samples >= 1 && o->samples <= 1000000, o->samples, w, "--samples", "must lie in [1, 1e6]");
-        check_value(o->threads >= 1 && o->threads <= 256, o->threads, w, "--threads", "must lie in [1, 256]");
-        check_outputs({{"--out", o->out}, {"--table", o->table}, {"--summary", o->summary}});
-        // This run's (L, q) values, by their CSV text: a row's seed is checked against the exact values where the
-        // 10 digits written lost some.
-        std::map<std::pair<std::string, std::string>, std::pair<double, double>> grid;
-        const int nq = static_cast<int>(std::floor((o->q_max - o->q_min) / o->q_step + 1e-9)) + 1;
-        auto q_at = [&](int k) { return std::round((o->q_min + k * o->q_step) * 1e9) / 1e9; };  // the k-th density
-        for (double L : o->L)
-            for (int k = 0; k < nq; ++k) grid[{fmt(L), fmt(q_at(k))}] = {L, q_at(k)};
-        auto short_text = [](double v) {  // fewer than 10 significant digits in the CSV: parsed back exactly
-            int digits = 0;
-            bool leading = true;
-            for (char ch : fmt(v)) {
-                if (ch == 'e' || ch == 'E') break;
-                if (ch < '0' || ch > '9') continue;
-                if (leading && ch == '0') continue;
-                leading = false, ++digits;
-            }
-            return digits < 10;
-        };
-        auto seed_of = [&](const PercolationSample& r) -> std::optional<std::uint64_t> {
-            auto it = grid.find({fmt(r.L), fmt(r.q)});
-            if (it != grid.end()) return percolation_seed(o->seed, it->second.first, it->second.second, r.sample);
-            if (short_text(r.L) && short_text(r.q)) return percolation_seed(o->seed, r.L, r.q, r.sample);
-            return std::nullopt;
-        };
-        std::vector<PercolationSample> rows;
-        bool newline = true;
-        {
-            std::ifstream probe(o->out);
-            if (probe.good()) {
-                if (!o->resume) throw InputError(w + ": --out " + o->out + " exists; add --resume to continue it");
-                rows = read_rows(o->out, o->pl, o->seed, seed_of, newline);
-            }
-        }
-        std::set<Key> done;
-        for (const auto& r : rows) done.insert({fmt(r.L), fmt(r.q), r.sample});
-        struct Item {
-            double L, q;
-            int sample;
-        };
-        std::vector<Item> todo;
-        for (double L : o->L)
-            for (int k = 0; k < nq; ++k) {
-                const double q = q_at(k);
-                for (int s = 0; s < o->samples; ++s)
-                    if (!done.count({fmt(L), fmt(q), s})) todo.push_back({L, q, s});
-            }
-        if (!todo.empty()) {
-            std::ofstream csv(o->out, std::ios::app);
-            if (!csv) throw InputError(w + ": cannot open --out " + o->out + " for writing");
-            if (rows.empty() && done.empty()) {
-                std::ifstream probe(o->out);
-                if (probe.peek() == std::ifstream::traits_type::eof()) csv << kHeader << '\n';
-            }
-            if (!newline) csv << '\n';
-            csv.flush();
-            std::mutex mu;
-            std::atomic<size_t> next{0};
-            size_t finished = 0;
-            const auto t0 = std::chrono::steady_clock::now();
-            double last_report = 0;
-            auto worker = [&] {
-                for (size_t i; (i = next++) < todo.size();) {
-                    const PercolationSample s = percolation_sample(o->pl, todo[i].L, todo[i].q, todo[i].sample, o->seed);
-                    std::lock_guard<std::mutex> lock(mu);
-                    csv << csv_line(s) << std::flush;
-                    if (!csv) {  // a full device: stop taking samples; reported after the pool
-                        next = todo.size();
-                        return;
-                    }
-                    rows.push_back(s);
-                    ++finished;
-                    const double t = seconds_since(t0);
-                    if (t - last_report > 2 || finished == todo.size()) {
-                        last_report = t;
-                        std::cerr << "percolation pl=" << o->pl << ": " << finished << "/" << todo.size() << " samples, "
-                                  << static_cast<int>(t) << " s, last L=" << s.L << " q=" << s.q << "\n";
-                    }
-                }
-            };
-            std::vector<std::thread> pool;
-            for (int t = 0; t < o->threads; ++t) pool.emplace_back(worker);
-            for (auto& t : pool) t.join();
-            if (!csv) throw OutputError("cannot append samples to --out '" + o->out + "' (" + std::to_string(finished) +
-                                        " written; --resume continues)");
-        }
-        // P(q) per L from every row in the CSV (earlier runs with other q ranges included).
-        std::map<double, std::map<double, std::array<int, 3>>> counts;  // L -> q -> {n, rigid, connected}
-        for (const auto& r : rows) {
-            auto& c = counts[r.L][r.q];
-            c[0] += 1, c[1] += r.rigid, c[2] += r.connected;
-        }
-        std::ostringstream table;
-        table << "pl,L,q,samples,P_rigid,P_connected\n";
-        nlohmann::json per_L = nlohmann::json::array();
-        std::vector<double> Lr, yr, er, wr, wer, Lc, yc, ec, wc, wec;  // sizes with a probit fit: q_1/2, width
-        for (const auto& [L, byq] : counts) {
-            std::vector<double> qs;
-            std::vector<int> n, hr, hc;
-            for (const auto& [q, c] : byq) {
-                qs.push_back(q), n.push_back(c[0]), hr.push_back(c[1]), hc.push_back(c[2]);
-                table << fmt(o->pl) << ',' << fmt(L) << ',' << fmt(q) << ',' << c[0] << ',' << fmt(double(c[1]) / c[0]) << ','
-                      << fmt(double(c[2]) / c[0]) << '\n';
-            }
-            const ProbitFit fr = fit_spanning_probability(qs, hr, n), fc = fit_spanning_probability(qs, hc, n);
-            if (fr.ok)
-                Lr.push_back(L), yr.push_back(fr.q_half), er.push_back(fr.q_half_err), wr.push_back(fr.width),
-                    wer.push_back(fr.width_err);
-            if (fc.ok)
-                Lc.push_back(L), yc.push_back(fc.q_half), ec.push_back(fc.q_half_err), wc.push_back(fc.width),
-                    wec.push_back(fc.width_err);
-            long samples = 0;
-            for (int k : n) samples += k;
-            per_L.push_back({{"L", L}, {"samples", samples}, {"densities", qs.size()}, {"rigid", fit_json(fr)},
-                             {"connected", fit_json(fc)}});
-        }
-        if (!o->table.empty()) write_file_atomic(o->table, table.str());
-        // nu from the probit widths, width(L) = c L^(-1/nu), then q_c with nu held there (docs/rigidity.md).
-        const WidthScalingFit width_r = fit_width_scaling(Lr, wr, wer), width_c = fit_width_scaling(Lc, wc, wec);
-        double cpu = 0;
-        for (const auto& r : rows) cpu += r.seconds;
-        emit_json({{"pl", o->pl},
-                   {"csv", o->out},
-                   {"rows", rows.size()},
-                   {"sample_seconds_total", cpu},
-                   {"per_L", per_L},
-                   {"scaling",
-                    {{"model", "q_half(L) = q_c + A L^(-1/nu)"},
-                     {"rigid", fit_json(fit_finite_size_scaling(Lr, yr, er))},
-                     {"connected", fit_json(fit_finite_size_scaling(Lc, yc, ec))},
-                     // Known exponents: 2D rigidity percolation nu = 1.21 (Jacobs & Thorpe 1995, bond-diluted
-                     // triangular lattice), 2D connectivity percolation nu = 4/3 (exact).
-                     {"rigid_nu_1.21", fit_json(fit_finite_size_scaling_fixed_nu(Lr, yr, er, 1.21))},
-                     {"connected_nu_4/3", fit_json(fit_finite_size_scaling_fixed_nu(Lc, yc, ec, 4.0 / 3.0))},
-                     {"width_model", "width(L) = c L^(-1/nu)"},
-                     {"rigid_width", fit_json(width_r)},
-                     {"connected_width", fit_json(width_c)},
-                     {"rigid_width_without_smallest_L", fit_json(width_fit_without(Lr, wr, wer, false))},
-                     {"connected_width_without_smallest_L", fit_json(width_fit_without(Lc, wc, wec, false))},
-                     {"rigid_width_without_largest_L", fit_json(width_fit_without(Lr, wr, wer, true))},
-                     {"connected_width_without_largest_L", fit_json(width_fit_without(Lc, wc, wec, true))},
-                     {"rigid_nu_from_width", width_nu_json(fit_finite_size_scaling_width_nu(Lr, yr, er, width_r))},
-                     {"connected_nu_from_width",
-                      width_nu_json(fit_finite_size_scaling_width_nu(Lc, yc, ec, width_c))}}}},
-                  o->summary);
-    });
+    cmd->add_flag("-q,--quiet", o->quiet, "no progress lines on stderr");
+    cmd->callback([o] { run_percolation(*o); });
 }
 
 }  // namespace fibernet::cli

@@ -456,17 +456,11 @@ int run_scan(const SceneFlags& flags, const Options& o, const std::vector<std::s
     auto comm = start_scan_comm();
     std::vector<std::size_t> todo;
     const std::string verdict = comm->share(comm->rank() == 0 ? prepare(d, m, base, o, sh, command_line_text(argv), todo) : "");
-    auto leave = [&](int code, const std::string& message) {  // ranks > 0 end quietly: rank 0 reports
-        if (comm->rank() == 0) {
-            if (code == 2) throw InputError(message);
-            if (code == 4) throw OutputError(message);
-            return code;
-        }
-        comm.reset();
-        std::fflush(nullptr);
-        std::_Exit(code);
-    };
-    if (!verdict.empty()) return leave(verdict[1] == '4' ? 4 : 2, verdict.substr(2));
+    if (!verdict.empty()) {  // ranks > 0 end quietly: rank 0 reports
+        end_if_not_root(comm, verdict[1] == '4' ? 4 : 2);
+        if (verdict[1] == '4') throw OutputError(verdict.substr(2));
+        throw InputError(verdict.substr(2));
+    }
     one_thread_per_sample();
     g_interrupts = 0;
     SignalGuard signals;
@@ -476,13 +470,13 @@ int run_scan(const SceneFlags& flags, const Options& o, const std::vector<std::s
     {
         SampleWorker worker(d, m, base, comm->rank());
         out = comm->run(comm->rank() == 0 ? &queue : nullptr, [&](std::size_t i) {
-            if (g_interrupts > 0) return SampleReport{false, 0, true, "", ""};
+            if (g_interrupts > 0) return SampleReport{false, 0, true, "", "", ""};
             return worker(i);
         });
     }
     const double wall = seconds_since(t0);
     comm->barrier();  // every rank's journal is complete
-    if (comm->rank() != 0) return leave(0, "");
+    end_if_not_root(comm, 0);
     if (!out.input_error.empty()) throw InputError(out.input_error + " (the scan stopped; the samples finished before "
                                                    "are kept, and --resume continues once the input is fixed)");
     if (!out.output_error.empty()) throw OutputError(out.output_error);

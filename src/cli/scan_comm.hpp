@@ -5,6 +5,7 @@
 // journal of its own; only indices and short reports travel over MPI.
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "fibernet/ensemble/sample_queue.hpp"
@@ -17,8 +18,11 @@ struct SampleReport {
     bool interrupted = false;  // the sample was interrupted (not journaled): stop handing out samples
     std::string input_error;   // the job refused its input: stop, and the scan exits 2 with this message
     std::string output_error;  // a file could not be written: stop, exit 4
+    std::string payload;       // what rank 0 records for the sample (fibernet percolation's CSV row), if anything
 };
 using SampleRunner = std::function<SampleReport(std::size_t index)>;
+// Called on rank 0, one report at a time, for every finished sample of any rank (before the queue counts it).
+using ReportSink = std::function<void(std::size_t index, const SampleReport&)>;
 
 struct DispatchOutcome {
     bool interrupted = false;
@@ -34,8 +38,10 @@ public:
     // Rank 0's verdict (e.g. "the directory is ready") on every rank: its message, empty for "go on".
     virtual std::string share(const std::string& message_on_root) = 0;
     virtual void barrier() = 0;
-    // Runs the samples of `queue` (rank 0's; nullptr on the others) until it is empty or stopped.
-    virtual DispatchOutcome run(SampleQueue* queue, const SampleRunner& runner) = 0;
+    // Runs the samples of `queue` (rank 0's; nullptr on the others) until it is empty or stopped: on rank 0 on
+    // `threads` threads (a runner that is not thread-safe: 1), on the other ranks one at a time.
+    virtual DispatchOutcome run(SampleQueue* queue, const SampleRunner& runner, int threads = 1,
+                                const ReportSink& sink = {}) = 0;
 };
 
 // MPI when this process was started by an MPI launcher (mpirun, mpiexec, srun) and fibernet was built with MPI;
@@ -43,9 +49,18 @@ public:
 std::unique_ptr<ScanComm> start_scan_comm();
 bool built_with_mpi();
 
+// On a rank other than 0: ends it quietly with `code` (rank 0 reports for all): MPI finalized, process exited.
+// On rank 0: returns.
+void end_if_not_root(std::unique_ptr<ScanComm>& comm, int code);
+
 // The serial case, also the sample loop of every rank.
 std::unique_ptr<ScanComm> serial_scan_comm();
-// Feeds a report into the queue and the outcome; true when the queue should stop.
-bool take_report(SampleQueue& queue, std::size_t index, const SampleReport& r, DispatchOutcome& out);
+// Feeds a report into the sink, the queue and the outcome; true when the queue should stop. Not thread-safe.
+bool take_report(SampleQueue& queue, std::size_t index, const SampleReport& r, DispatchOutcome& out,
+                 const ReportSink& sink);
+// Runs samples from the queue on `threads` threads of this process (the calling one included) until it is empty or
+// stopped; `lock` serializes the reports (take_report).
+void run_local(SampleQueue& queue, const SampleRunner& runner, int threads, std::mutex& lock, DispatchOutcome& out,
+               const ReportSink& sink);
 
 }  // namespace fibernet::cli

@@ -3,6 +3,7 @@
 #include <mpi.h>
 
 #include <chrono>
+#include <exception>
 #include <cstdint>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -20,12 +21,13 @@ constexpr int kRequest = 1, kReply = 2;
 
 nlohmann::json report_json(std::size_t index, const SampleReport& r) {
     return {{"index", index}, {"ok", r.ok}, {"seconds", r.seconds}, {"interrupted", r.interrupted},
-            {"input_error", r.input_error}, {"output_error", r.output_error}};
+            {"input_error", r.input_error}, {"output_error", r.output_error}, {"payload", r.payload}};
 }
 SampleReport report_of(const nlohmann::json& j) {
     SampleReport r;
     r.ok = j.value("ok", false), r.seconds = j.value("seconds", 0.0), r.interrupted = j.value("interrupted", false);
     r.input_error = j.value("input_error", std::string()), r.output_error = j.value("output_error", std::string());
+    r.payload = j.value("payload", std::string());
     return r;
 }
 
@@ -54,8 +56,8 @@ public:
     }
     void barrier() override { MPI_Barrier(MPI_COMM_WORLD); }
 
-    DispatchOutcome run(SampleQueue* queue, const SampleRunner& runner) override {
-        return rank_ == 0 ? schedule(*queue, runner) : work(runner);
+    DispatchOutcome run(SampleQueue* queue, const SampleRunner& runner, int threads, const ReportSink& sink) override {
+        return rank_ == 0 ? schedule(*queue, runner, threads, sink) : work(runner);
     }
 
 private:
@@ -83,16 +85,17 @@ private:
 
     // Rank 0: a worker thread of its own takes from the queue while this thread answers the other ranks. The
     // probe polls (with a 1 ms sleep) rather than blocking: a blocking receive spins a core in Open MPI.
-    DispatchOutcome schedule(SampleQueue& queue, const SampleRunner& runner) {
+    DispatchOutcome schedule(SampleQueue& queue, const SampleRunner& runner, int threads, const ReportSink& sink) {
         DispatchOutcome out;
         std::mutex mu;
         std::thread local;
+        std::exception_ptr local_error;
         if (threaded_)
             local = std::thread([&] {
-                while (auto i = queue.next()) {
-                    const SampleReport r = runner(*i);
-                    std::lock_guard<std::mutex> lock(mu);
-                    if (take_report(queue, *i, r, out)) break;
+                try {
+                    run_local(queue, runner, threads, mu, out, sink);
+                } catch (...) {
+                    local_error = std::current_exception();
                 }
             });
         int active = size_ - 1;
@@ -111,7 +114,7 @@ private:
             const nlohmann::json reports = nlohmann::json::parse(text, nullptr, false);
             if (reports.is_array()) {
                 std::lock_guard<std::mutex> lock(mu);
-                for (const auto& j : reports) take_report(queue, j.at("index").get<std::size_t>(), report_of(j), out);
+                for (const auto& j : reports) take_report(queue, j.at("index").get<std::size_t>(), report_of(j), out, sink);
             }
             // Batches of about 50 ms of samples: a request's round trip (up to the 1 ms poll) is then small beside
             // the work it brings, while samples of a second or more still go one at a time.
@@ -121,10 +124,8 @@ private:
             if (batch.empty()) --active;
         }
         if (local.joinable()) local.join();
-        if (!threaded_) {  // no second thread: rank 0 runs what is left once the others are done
-            while (auto i = queue.next())
-                if (take_report(queue, *i, runner(*i), out)) break;
-        }
+        if (local_error) std::rethrow_exception(local_error);
+        if (!threaded_) run_local(queue, runner, threads, mu, out, sink);  // no second thread: what is left, now
         return out;
     }
 

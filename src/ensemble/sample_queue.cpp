@@ -17,8 +17,8 @@ std::string human_duration(double s) {
     return b;
 }
 
-SampleQueue::SampleQueue(std::vector<std::size_t> todo, double report_seconds)
-    : todo_(std::move(todo)), report_seconds_(report_seconds) {}
+SampleQueue::SampleQueue(std::vector<std::size_t> todo, double report_seconds, std::string label)
+    : todo_(std::move(todo)), report_seconds_(report_seconds), label_(std::move(label)) {}
 
 std::optional<std::size_t> SampleQueue::next() {
     std::lock_guard<std::mutex> lock(mu_);
@@ -81,7 +81,7 @@ std::string SampleQueue::progress_line() const {
 
 std::string SampleQueue::line_locked() const {
     const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
-    std::string s = "scan: " + std::to_string(done_) + "/" + std::to_string(todo_.size()) + " samples";
+    std::string s = label_ + ": " + std::to_string(done_) + "/" + std::to_string(todo_.size()) + " samples";
     if (failed_ > 0) s += " (" + std::to_string(failed_) + " failed)";
     s += ", " + human_duration(t);
     if (done_ > 0 && done_ < todo_.size())

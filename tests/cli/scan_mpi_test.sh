@@ -47,3 +47,14 @@ kept=$( (cat "$t"/killed/journal/*.jsonl || true) | grep -c '"index"' || true)
   fail "the resumed scan exited $? ($(head -c 400 "$t/resumed.err"))"
 cmp -s "$t/serial_slow/samples.csv" "$t/killed/samples.csv" || fail "after a killed rank and --resume: samples.csv differs"
 echo "scan_mpi_test: a rank killed after $kept samples; --resume gives the serial rows"
+
+# fibernet percolation on the same ranks: the rows (sorted: they arrive as they finish) and the fits of a serial run.
+perc=(percolation --pl 1 --L 3,4 --q-min 5 --q-max 7 --q-step 0.5 --samples 10 -q)
+"$fibernet" "${perc[@]}" --threads 1 --out "$t/perc_serial.csv" > "$t/perc_serial.json"
+"${mpi[@]}" -n 3 "$fibernet" "${perc[@]}" --out "$t/perc_mpi.csv" > "$t/perc_mpi.json" 2> "$t/perc_mpi.err" ||
+  fail "percolation under mpirun -n 3 exited $? ($(head -c 400 "$t/perc_mpi.err"))"
+rows() { tail -n +2 "$1" | cut -d, -f1-9 | sort; }
+[ "$(rows "$t/perc_serial.csv")" = "$(rows "$t/perc_mpi.csv")" ] || fail "percolation: the MPI rows differ from the serial ones"
+fits() { python3 -c "import json,sys; j=json.load(open(sys.argv[1])); print(json.dumps([j['per_L'], j['scaling']], sort_keys=True))" "$1"; }
+[ "$(fits "$t/perc_serial.json")" = "$(fits "$t/perc_mpi.json")" ] || fail "percolation: the MPI fits differ from the serial ones"
+echo "scan_mpi_test: percolation on 3 ranks: the serial rows and fits"

@@ -13,8 +13,9 @@ namespace fibernet {
 
 class SampleQueue {
 public:
-    // todo: the indices to run, in order; progress lines go to stderr every `report_seconds` (none if < 0).
-    SampleQueue(std::vector<std::size_t> todo, double report_seconds);
+    // todo: the indices to run, in order; progress lines ("<label>: 37/96 samples ...") go to stderr every
+    // `report_seconds` (none if < 0).
+    SampleQueue(std::vector<std::size_t> todo, double report_seconds, std::string label = "scan");
     std::optional<std::size_t> next();  // nullopt once every sample is handed out, or after stop()
     // Up to `max` samples for a worker that asks over a network: as many as take about `target_seconds` at the mean
     // sample time so far (one while nothing has finished), but at most a quarter of what is left per worker, so
@@ -35,6 +36,7 @@ private:
     std::vector<std::size_t> todo_;
     std::size_t next_ = 0, done_ = 0, failed_ = 0;
     double busy_ = 0, report_seconds_, last_report_ = 0;
+    std::string label_;
     bool stopped_ = false;
     std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };
