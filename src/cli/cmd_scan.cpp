@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "common.hpp"
+#include "fibernet_version.hpp"
 #include "scan_comm.hpp"
 #include "scan_job.hpp"
 #include "fibernet/ensemble/grid.hpp"
@@ -206,7 +207,7 @@ void claim_dir(const ScanDir& d, const Manifest& m, bool resume, bool shard, con
                              "it lacks");
         return;
     }
-    make_dirs(d, m.sample_files);
+    make_dirs(d, m.sample_files || m.job == "sweep");
     nlohmann::json j = want;
     j["format"] = "fibernet-scan 1";
     j["fibernet"] = {{"version", FIBERNET_VERSION}, {"commit", FIBERNET_GIT_COMMIT}};
@@ -400,7 +401,7 @@ int merge_scan(const ScanDir& d, const std::vector<std::string>& sources) {
     if (!fs::exists(d.manifest())) {  // a new directory: the first source's scan
         const nlohmann::json j = read_json_file(ScanDir{sources.front()}.manifest());
         Manifest::from(j, sources.front());
-        make_dirs(d, j.value("sample_files", false));
+        make_dirs(d, j.value("sample_files", false) || j.value("job", "") == "sweep");
         write_file_atomic(d.manifest(), json_text(j, 2) + "\n");
     }
     Scene base;

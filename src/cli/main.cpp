@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "common.hpp"
+#include "fibernet_version.hpp"
 #include "fibernet/util/error.hpp"
 #include "fibernet/util/parallel.hpp"
 

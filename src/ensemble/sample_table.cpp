@@ -64,10 +64,12 @@ std::string csv_field(const nlohmann::json& v) {
 
 std::string samples_csv(const Grid& grid, const std::vector<const nlohmann::json*>& records) {
     const auto cols = result_columns(records);
+    std::set<std::string> leading = {"index", "status", "exit_code"};
     std::string out = "index";
-    for (const auto& a : grid.axes) out += "," + header_field(a.name);
+    for (const auto& a : grid.axes) out += "," + header_field(a.name), leading.insert(a.name);
     out += ",status,exit_code";
-    for (const auto& c : cols) out += "," + header_field(c);
+    // A result's own "status" (or a key named like an axis) under "result." so that no two columns share a name.
+    for (const auto& c : cols) out += "," + header_field(leading.count(c) ? "result." + c : c);
     out += "\n";
     for (const auto* r : records) {
         const std::size_t index = (*r)["index"].get<std::size_t>();
@@ -114,10 +116,14 @@ std::string summary_csv(const Grid& grid, const std::vector<const nlohmann::json
         if (any && !bad) numeric.push_back(c);
     }
     std::string out;
+    std::set<std::string> leading = {"samples", "ok"};
     for (std::size_t k = 0; k < grid.axes.size(); ++k)
-        if (!grid.replica_axis(k)) out += header_field(grid.axes[k].name) + ",";
+        if (!grid.replica_axis(k)) out += header_field(grid.axes[k].name) + ",", leading.insert(grid.axes[k].name);
     out += "samples,ok";
-    for (const auto& c : numeric) out += "," + header_field(c + ".mean") + "," + header_field(c + ".sem");
+    for (const auto& c : numeric) {
+        const std::string name = leading.count(c) ? "result." + c : c;
+        out += "," + header_field(name + ".mean") + "," + header_field(name + ".sem");
+    }
     out += "\n";
     for (const auto& [pi, p] : points) {
         const auto coord = grid.coordinates(p.first_index);

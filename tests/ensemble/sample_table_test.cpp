@@ -50,6 +50,10 @@ TEST_CASE("sample_table: rows in index order, mean and standard error per point"
     REQUIRE(s.size() == 7);
     CHECK(s[0] == std::vector<std::string>{"index", "q", "seed", "status", "exit_code", "moduli.G"});
     CHECK(s[5] == std::vector<std::string>{"4", "8", "2", "converged", "0", "20"});
+    std::vector<nlohmann::json> named = {{{"index", 0}, {"status", "completed"}, {"exit_code", 0},
+                                          {"result", {{"status", "completed"}, {"q", 1}}}}};
+    CHECK(rows(samples_csv(g, {&named[0]}))[0] ==
+          std::vector<std::string>{"index", "q", "seed", "status", "exit_code", "result.q", "result.status"});
     const auto m = rows(summary_csv(g, p));
     REQUIRE(m.size() == 3);
     CHECK(m[0] == std::vector<std::string>{"q", "samples", "ok", "moduli.G.mean", "moduli.G.sem"});
