@@ -427,6 +427,9 @@ void register_wet(CLI::App& app) {
               << "\n";
             g_message = m.str();
         };
+        // A fresh run: fibernet scan runs this command once per sample in one process, and the last run's final
+        // write left the state held (kWriting), where hold() would wait for ever.
+        g_state = kRunning, g_pending = false;
         hold();  // before the handler exists: nothing to report until checkpoint(0) has run
         InterruptScope interrupts;
         checkpoint(0);

@@ -8,12 +8,21 @@
 namespace fibernet {
 
 namespace {
+constexpr std::size_t kMaxListedObjects = 16;
+
 void flatten_into(const nlohmann::json& j, const std::string& prefix, std::vector<std::pair<std::string, nlohmann::json>>& out) {
     for (const auto& [k, v] : j.items()) {
         if (k == "seconds") continue;  // wall times differ from run to run
         const std::string name = prefix.empty() ? k : prefix + "." + k;
-        if (v.is_object()) flatten_into(v, name, out);
-        else if (!v.is_array()) out.emplace_back(name, v);
+        if (v.is_object()) {
+            flatten_into(v, name, out);
+        } else if (v.is_array()) {  // a short list of objects (fibernet wet's runs, one per beta): each by index
+            if (v.size() > kMaxListedObjects || v.empty() || !v.front().is_object()) continue;
+            for (std::size_t i = 0; i < v.size(); ++i)
+                if (v[i].is_object()) flatten_into(v[i], name + "." + std::to_string(i), out);
+        } else {
+            out.emplace_back(name, v);
+        }
     }
 }
 

@@ -173,3 +173,27 @@ TEST_CASE("cli scan: bad grids, jobs and arguments exit 2 before any work and le
         CHECK(!std::filesystem::exists(d));
     }
 }
+
+TEST_CASE("cli scan: every job, two samples each in one process", "[cli][scan]") {
+    // The second sample of a job runs after the first in the same process: a command's leftover state must not
+    // change or stop it (wet's interrupt state once made the second sample wait for ever; hence the timeout).
+    const std::vector<std::pair<std::string, std::string>> jobs = {
+        {"relax", "--L 3 --scheme even --vary gamma=0.01,0.02 --job relax"},
+        {"rigidity", "--L 3 --open --vary seed=1:2 --job rigidity --sample-files"},
+        {"sweep", "--L 3 --q 7 --scheme even --h 2.5 --vary seed=1:2 --job sweep --job-args \"--gamma-max 0.02 --step 0.01\""},
+        {"wet", "--L 2.2 --q 6 --pl 0.5 --vary beta=0.1,0.2 --job wet --job-args --no-moduli"},
+    };
+    for (const auto& [job, args] : jobs) {
+        INFO(job);
+        const std::string d = dir("job_" + job);
+        const std::string cmd = "timeout 300 " + std::string(FIBERNET_EXE) + " scan " + args + " -q -o " + d + " > " +
+                                tmpdir() + "/stdout 2> " + tmpdir() + "/stderr";
+        CHECK(WEXITSTATUS(std::system(cmd.c_str())) == 0);
+        const auto rows = lines(slurp(d + "/samples.csv"));
+        REQUIRE(rows.size() == 3);
+        CHECK(rows[2].find(",0,") != std::string::npos);
+        if (job == "sweep") CHECK(lines(slurp(d + "/samples/sample-1.csv")).size() == 4);  // header and 3 steps
+        if (job == "rigidity") CHECK(std::filesystem::exists(d + "/samples/sample-1.svg"));
+        if (job == "wet") CHECK(rows[0].find(",runs.0.pores.wet.count,") != std::string::npos);
+    }
+}

@@ -24,11 +24,13 @@ std::vector<std::vector<std::string>> rows(const std::string& csv) {
 
 TEST_CASE("sample_table: flattening leaves out arrays and timings", "[ensemble]") {
     const nlohmann::json r = {{"moduli", {{"G", 1.5}, {"seconds", 2}}}, {"list", {1, 2}}, {"seconds", {{"total", 3}}},
-                              {"status", "converged"}};
+                              {"runs", {{{"beta", 0.5}}, {{"beta", 1}}}}, {"status", "converged"}};
     const auto f = flatten_result(r);
-    REQUIRE(f.size() == 2);
+    REQUIRE(f.size() == 4);
     CHECK(f[0].first == "moduli.G");
-    CHECK(f[1].first == "status");
+    CHECK(f[1].first == "runs.0.beta");  // a short list of objects, by index
+    CHECK(f[2].first == "runs.1.beta");
+    CHECK(f[3].first == "status");
     CHECK(csv_field(0.1) == "0.10000000000000001");
     CHECK(std::strtod(csv_field(1.0 / 3).c_str(), nullptr) == 1.0 / 3);
     CHECK(csv_field(42) == "42");

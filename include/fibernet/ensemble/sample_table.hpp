@@ -2,8 +2,8 @@
 // An ensemble's results as tables (docs/scan.md, "Files"): samples.csv, one row per finished sample in index order,
 // and summary.csv, the mean and standard error over the replicas (seeds) of each grid point. The columns are the
 // grid's axes, the sample's status, and every number, boolean and string of the job's JSON result under its dotted
-// path (moduli.G, solver.iterations); arrays and timings ("seconds") stay in samples.jsonl, so the rows are the same
-// bit for bit however the ensemble was run.
+// path (moduli.G, solver.iterations; the objects of a list of at most 16 by index, runs.0.pores.count); other arrays
+// and timings ("seconds") stay in samples.jsonl, so the rows are the same bit for bit however the ensemble was run.
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
@@ -13,7 +13,8 @@
 
 namespace fibernet {
 
-// The scalars of a JSON object by dotted path, in the object's key order; arrays and "seconds" members are left out.
+// The scalars of a JSON object by dotted path, in the object's key order, with the objects of lists of at most 16
+// objects by index; other arrays and "seconds" members are left out.
 std::vector<std::pair<std::string, nlohmann::json>> flatten_result(const nlohmann::json& result);
 
 // A scalar as a CSV field: integers as such, other numbers with 17 significant digits (they read back exactly),
