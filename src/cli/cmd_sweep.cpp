@@ -225,6 +225,7 @@ void register_sweep(CLI::App& app) {
     cmd->footer("Like `fibernet percolation --out`, the checkpoint of an unfinished sweep is refused without --resume "
                 "(its sweep would be lost); a completed sweep, or an existing CSV without a checkpoint, is replaced.");
     cmd->callback([=] {
+        g_stop = false;  // a fresh run (fibernet scan runs sweeps one after another in one process)
         Scene s = flags->resolve();
         if (flags->given("--gamma")) throw InputError("command line: sweep takes --gamma-max, not --gamma");
         p->kind = s.strain;
@@ -270,7 +271,11 @@ void register_sweep(CLI::App& app) {
         SweepCallbacks cb;
         cb.stop = &g_stop;
         SweepState last = start;
+        nlohmann::json last_step = nullptr;  // the last row written by this run, for summaries (fibernet scan)
         cb.on_step = [&](const SweepRow& r, const SweepState& st) {
+            last_step = {{"step", r.step},       {"gamma", r.t},          {"sigma_xx", r.sigma(0, 0)},
+                         {"sigma_xy", r.sigma(0, 1)}, {"sigma_yy", r.sigma(1, 1)}, {"stress_path", r.stress_path},
+                         {"K", r.K},             {"K_affine", r.K_affine}, {"energy", r.energy}};
             csv << csv_row(r) << '\n' << std::flush;
             if (!csv) throw OutputError("cannot append step " + std::to_string(r.step) + " to '" + *out + "'");
             write_checkpoint(*ckpt, params, ++rows, st);
@@ -301,6 +306,7 @@ void register_sweep(CLI::App& app) {
                    {"rows", rows},
                    {"output", rows > 0 ? nlohmann::json(*out) : nlohmann::json()},
                    {"checkpoint", rows > 0 ? nlohmann::json(*ckpt) : nlohmann::json()},
+                   {"last_step", last_step},
                    {"model", to_json(summarize(m))}});
         if (o.interrupted) exit_code() = 130;
         else if (!o.completed) exit_code() = 1;
