@@ -44,7 +44,7 @@ extern "C" void on_scan_signal(int) {
 }
 
 struct Options {
-    std::vector<std::string> vary, merge;
+    std::vector<std::string> vary, merge, points;
     std::string job, job_args, out, shard;
     bool resume = false, quiet = false, sample_files = false;
     long long print_scene = -1;
@@ -100,7 +100,8 @@ struct Manifest {
     nlohmann::json determining() const {
         nlohmann::json axes = nlohmann::json::array();
         for (const auto& a : grid.axes)
-            axes.push_back({{"name", a.name}, {"key", a.key}, {"values", a.values}, {"labels", a.labels}});
+            axes.push_back({{"name", a.name}, {"key", a.key}, {"values", a.values}, {"labels", a.labels},
+                            {"group", a.group}});
         return {{"job", job}, {"job_args", job_args}, {"axes", axes}, {"scene", scene}, {"sample_files", sample_files},
                 {"samples", grid.size()}};
     }
@@ -113,7 +114,7 @@ struct Manifest {
             for (const auto& a : j.at("axes"))
                 m.grid.axes.push_back({a.at("name").get<std::string>(), a.at("key").get<std::string>(),
                                        a.at("values").get<std::vector<std::string>>(),
-                                       a.at("labels").get<std::vector<std::string>>()});
+                                       a.at("labels").get<std::vector<std::string>>(), a.value("group", -1)});
         } catch (const nlohmann::json::exception& e) {
             throw InputError(where + ": not a scan manifest (" + e.what() + ")");
         }
@@ -354,6 +355,9 @@ Manifest manifest_of(const SceneFlags& flags, const Options& o, Scene& base) {
     m.job = o.job;
     m.job_args = split_args(o.job_args);
     check_job_args(m.job, m.job_args);
+    for (std::size_t k = 0; k < o.points.size(); ++k)  // the lists of points first, then the --vary axes
+        for (auto& a : parse_points(file_bytes(o.points[k], "--points file"), o.points[k], static_cast<int>(k)))
+            m.grid.axes.push_back(std::move(a));
     for (const auto& v : o.vary) m.grid.axes.push_back(parse_axis(v, "command line"));
     check_grid(m.grid, kMaxSamples, "command line");
     base = base_scene(flags);
@@ -508,7 +512,7 @@ int run_scan_command(const SceneFlags& flags, const Options& o, const std::vecto
     const ScanDir d{o.out};
     if (o.print_scene_given) return print_scene(d, o.print_scene);
     if (!o.merge.empty()) {
-        if (!o.vary.empty() || !o.job.empty() || o.resume)
+        if (!o.vary.empty() || !o.points.empty() || !o.job.empty() || o.resume)
             throw InputError("command line: --merge takes only -o and the source directories (their scan is in "
                              "their scan.json)");
         return merge_scan(d, o.merge);
@@ -524,6 +528,8 @@ void register_scan(CLI::App& app) {
     auto o = std::make_shared<Options>();
     cmd->add_option("--vary", o->vary, "an axis: key=v1,v2,... | key=first:last | key=first:last:step (repeatable; "
                                        "key: L, q, pl, seed, a, h, scheme, gamma, beta, ... or table.key)");
+    cmd->add_option("--points", o->points, "a list of points: a CSV file, a header of keys (e.g. L,q), a row per "
+                                           "point; its columns vary together (repeatable; before the --vary axes)");
     cmd->add_option("--job", o->job, "the command run per sample: modulus | relax | rigidity | sweep | wet");
     cmd->add_option("--job-args", o->job_args, "the job's own flags, e.g. \"--start linear\" (space-separated)");
     cmd->add_option("-o,--out-dir", o->out, "the scan's directory (scan.json, journal/, samples.csv, summary.csv)")

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <set>
+#include <sstream>
 
 #include "fibernet/scene/scene_toml.hpp"
 #include "fibernet/util/error.hpp"
@@ -117,17 +119,74 @@ GridAxis parse_axis(const std::string& spec, const std::string& where) {
     return ax;
 }
 
+std::vector<GridAxis> parse_points(const std::string& text, const std::string& where, int group) {
+    std::vector<std::vector<std::string>> rows;
+    std::istringstream is(text);
+    int lineno = 0;
+    for (std::string line; std::getline(is, line);) {
+        ++lineno;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.empty() || line[0] == '#') continue;
+        rows.push_back(split(line, ','));
+        for (auto& f : rows.back()) {
+            f.erase(0, f.find_first_not_of(" \t"));
+            f.erase(f.find_last_not_of(" \t") + 1);
+            if (f.empty()) throw InputError(where + ":" + std::to_string(lineno) + ": an empty field");
+        }
+        if (rows.size() > 1 && rows.back().size() != rows.front().size())
+            throw InputError(where + ":" + std::to_string(lineno) + ": " + std::to_string(rows.back().size()) +
+                             " fields, the header has " + std::to_string(rows.front().size()));
+    }
+    if (rows.size() < 2) throw InputError(where + ": no points (a header of scene keys, then one row per point)");
+    std::vector<GridAxis> axes(rows.front().size());
+    for (std::size_t c = 0; c < axes.size(); ++c) {
+        axes[c].name = rows.front()[c];
+        axes[c].key = grid_key(axes[c].name, where + ": column " + std::to_string(c + 1));
+        axes[c].group = group;
+    }
+    std::set<std::vector<std::string>> seen;
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+        std::vector<std::string> point;
+        for (std::size_t c = 0; c < axes.size(); ++c) {
+            const auto [lit, label] = literal(rows[r][c]);
+            axes[c].values.push_back(lit), axes[c].labels.push_back(label), point.push_back(lit);
+        }
+        if (!seen.insert(point).second) throw InputError(where + ": point " + std::to_string(r) + " is given twice");
+    }
+    return axes;
+}
+
+namespace {
+// The axes that share a coordinate: each group's axis indices, in the order of their first axis.
+std::vector<std::vector<std::size_t>> coordinate_groups(const std::vector<GridAxis>& axes) {
+    std::vector<std::vector<std::size_t>> groups;
+    std::map<int, std::size_t> of_group;
+    for (std::size_t k = 0; k < axes.size(); ++k) {
+        if (axes[k].group >= 0) {
+            const auto [it, fresh] = of_group.emplace(axes[k].group, groups.size());
+            if (fresh) groups.emplace_back();
+            groups[it->second].push_back(k);
+        } else {
+            groups.push_back({k});
+        }
+    }
+    return groups;
+}
+}  // namespace
+
 std::size_t Grid::size() const {
     std::size_t n = 1;
-    for (const auto& a : axes) n *= a.values.size();
+    for (const auto& g : coordinate_groups(axes)) n *= axes[g.front()].values.size();
     return n;
 }
 
 std::vector<std::size_t> Grid::coordinates(std::size_t index) const {
     std::vector<std::size_t> c(axes.size());
-    for (std::size_t k = axes.size(); k-- > 0;) {
-        c[k] = index % axes[k].values.size();
-        index /= axes[k].values.size();
+    const auto groups = coordinate_groups(axes);
+    for (std::size_t k = groups.size(); k-- > 0;) {
+        const std::size_t len = axes[groups[k].front()].values.size();
+        for (std::size_t a : groups[k]) c[a] = index % len;
+        index /= len;
     }
     return c;
 }
@@ -139,22 +198,31 @@ std::map<std::string, std::string> Grid::replacements(std::size_t index) const {
     return r;
 }
 
-bool Grid::replica_axis(std::size_t k) const { return axes[k].key == "network.seed" || axes[k].key == "wet.seed"; }
+bool Grid::replica_axis(std::size_t k) const {
+    return axes[k].group < 0 && (axes[k].key == "network.seed" || axes[k].key == "wet.seed");  // a point's seed: no
+}
 
 std::size_t Grid::point(std::size_t index) const {
     const auto c = coordinates(index);
     std::size_t p = 0;
-    for (std::size_t k = 0; k < axes.size(); ++k)
-        if (!replica_axis(k)) p = p * axes[k].values.size() + c[k];
+    for (const auto& g : coordinate_groups(axes)) {
+        bool replicas = true;  // a group of seeds only (a list of points with a seed column is a point)
+        for (std::size_t a : g) replicas = replicas && replica_axis(a);
+        if (!replicas) p = p * axes[g.front()].values.size() + c[g.front()];
+    }
     return p;
 }
 
 void check_grid(const Grid& g, std::size_t max_samples, const std::string& where) {
     std::set<std::string> keys;
-    double n = 1;
-    for (const auto& a : g.axes) {
+    for (const auto& a : g.axes)
         if (!keys.insert(a.key).second) throw InputError(where + ": --vary " + a.name + ": " + a.key + " is varied twice");
-        n *= static_cast<double>(a.values.size());
+    double n = 1;
+    for (const auto& grp : coordinate_groups(g.axes)) {
+        for (std::size_t a : grp)
+            if (g.axes[a].values.size() != g.axes[grp.front()].values.size() || g.axes[a].values.empty())
+                throw InputError(where + ": the axes of a list of points differ in length");
+        n *= static_cast<double>(g.axes[grp.front()].values.size());
     }
     if (n > static_cast<double>(max_samples))
         throw InputError(where + ": the grid has " + show(n) + " samples, more than " + std::to_string(max_samples));

@@ -197,3 +197,20 @@ TEST_CASE("cli scan: every job, two samples each in one process", "[cli][scan]")
         if (job == "wet") CHECK(rows[0].find(",runs.0.pores.wet.count,") != std::string::npos);
     }
 }
+
+TEST_CASE("cli scan: a list of points with seeds", "[cli][scan]") {
+    const std::string d = dir("points"), pts = tmpdir() + "/points.csv";
+    write(pts, "L,q\n3,6\n4,8\n");
+    REQUIRE(run("scan --scheme even --points " + pts + " --vary seed=1:2 --job modulus -q -o " + d) == 0);
+    const auto rows = lines(slurp(d + "/samples.csv"));
+    REQUIRE(rows.size() == 5);
+    CHECK(rows[0].rfind("index,L,q,seed,", 0) == 0);
+    CHECK(rows[3].rfind("2,4,8,1,", 0) == 0);
+    const auto summary = lines(slurp(d + "/summary.csv"));
+    REQUIRE(summary.size() == 3);
+    CHECK(summary[0].rfind("L,q,samples,ok,", 0) == 0);
+    CHECK(summary[2].rfind("4,8,2,2,", 0) == 0);
+    write(pts, "L,q\n3,6\n3,6\n");
+    CHECK(run("scan --points " + pts + " --job modulus -q -o " + dir("points_bad")) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("point 2 is given twice") != std::string::npos);
+}

@@ -67,3 +67,21 @@ TEST_CASE("grid: bad specifications name the value", "[ensemble]") {
     g.axes = {parse_axis("q=1,2,3", "t"), parse_axis("seed=1:40", "t")};
     CHECK_THROWS_WITH(check_grid(g, 100, "here"), Catch::Contains("120 samples, more than 100"));
 }
+
+TEST_CASE("grid: a list of points varies its columns together", "[ensemble]") {
+    Grid g;
+    g.axes = parse_points("# L and q together\nL,q,seed\n10, 8,1\n20,16,1\n", "pts.csv", 0);
+    g.axes.push_back(parse_axis("a=10,100", "t"));
+    REQUIRE(g.size() == 4);  // 2 points x 2 values of a
+    CHECK(g.replacements(2).at("network.L") == "20");
+    CHECK(g.replacements(2).at("network.q") == "16");
+    CHECK(g.replacements(2).at("model.a") == "10");
+    CHECK(!g.replica_axis(2));  // a seed column of the points is part of the point
+    CHECK(g.point(3) == 3);
+    check_grid(g, 100, "t");
+    CHECK_THROWS_WITH(parse_points("L,q\n10,8\n10,8\n", "p.csv", 0), Catch::Contains("p.csv: point 2 is given twice"));
+    CHECK_THROWS_WITH(parse_points("L,q\n10\n", "p.csv", 0), Catch::Contains("p.csv:2: 1 fields, the header has 2"));
+    CHECK_THROWS_WITH(parse_points("L,density\n10,8\n", "p.csv", 0), Catch::Contains("'density' is not a scene key"));
+    CHECK_THROWS_WITH(parse_points("L,q\n", "p.csv", 0), Catch::Contains("no points"));
+    CHECK_THROWS_WITH(parse_points("L,q\n10,\n", "p.csv", 0), Catch::Contains("p.csv:2: an empty field"));
+}
