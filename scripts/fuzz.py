@@ -19,6 +19,8 @@ Formats (--formats, comma-separated; default all):
               positional scene (a non-scene file there must get a message that says so), --network, --law, a sweep
               checkpoint, a percolation CSV
   paths       valid inputs and outputs under odd file names (invalid UTF-8, a newline, a leading '-', ...)
+  points      lists of points (`fibernet scan --points FILE`, docs/scan.md) for a scan of pebble games; a scan that
+              runs must give one samples.csv row per point
 
 Each case gets a fresh directory with its input files, runs one fibernet command (timeout, 1 process at a time,
 OMP/OpenBLAS/FIBERNET threads = 1, address space limited) and is classified:
@@ -51,7 +53,7 @@ import random
 from fibernet_runs import child_env, child_limits, parse_json
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-FORMATS = ["network", "scene", "law", "sweep_ckpt", "percolation", "model", "foreign", "paths"]
+FORMATS = ["network", "scene", "law", "sweep_ckpt", "percolation", "model", "foreign", "paths", "points"]
 DEFAULT_SEED = 20261201
 TINY = ["--L", "2.5", "--q", "4"]
 
@@ -348,7 +350,7 @@ GENERIC = [(m_byte_flip, 2), (m_invalid_utf8, 2), (m_truncate, 2), (m_line_op, 3
            (m_insert_line, 2), (m_whitespace, 1), (m_token, 2)]
 EXTRA = {"scene": [(m_toml, 6)], "sweep_ckpt": [(m_ckpt_header, 5), (m_ckpt_params, 1)],
          "sweep_csv": [(m_csv_field, 4)],
-         "percolation": [(m_csv_field, 6)]}
+         "percolation": [(m_csv_field, 6)], "points": [(m_csv_field, 6)]}
 
 
 def mutate(rng, b, kind, n=None):
@@ -442,8 +444,9 @@ class Case:
 
 
 EXPECTED_RC = {"info": {0, 2}, "export": {0, 2}, "generate": {0, 2}, "rigidity": {0, 2}, "percolation": {0, 2},
-               "modulus": {0, 1, 2}, "relax": {0, 1, 2}, "sweep": {0, 1, 2}, "wet": {0, 1, 2}, "compare": {0, 1, 2}}
-JSON_STDOUT = {"info", "modulus", "relax", "sweep", "wet", "rigidity", "percolation", "compare"}
+               "modulus": {0, 1, 2}, "relax": {0, 1, 2}, "sweep": {0, 1, 2}, "wet": {0, 1, 2}, "compare": {0, 1, 2},
+               "scan": {0, 1, 2}}
+JSON_STDOUT = {"info", "modulus", "relax", "sweep", "wet", "rigidity", "percolation", "compare", "scan"}
 
 
 def names_something(err, case):
@@ -884,6 +887,8 @@ free_box_tol = 1e-3
         c("percolation", *PERC_ARGS, "--out", "p_full.csv")
         full = self.read("p_full.csv")
         self.put("p.csv", b"".join(_lines(full)[:5]))  # 4 of 6 samples: --resume has 2 to run
+        self.put("pts.csv", b"L,q,seed\n2.5,4,1\n3,5,2\n3,5,3\n")
+        self.files["pts.csv"] = self.read("pts.csv")
         c("wet", "--L", "2.5", "--q", "4", "--betas", "0,0.1", "-q", "-o", "wetout")
         self.read("wetout/summary.json"), self.read("wetout/sweep.csv"), self.read("wetout/network.svg")
 
@@ -1027,6 +1032,27 @@ def gen_percolation(rng, i, seeds):
              outputs=("p.csv",))
     c.skip_nonfinite = {"p.csv"}  # its rows came from the mutated input; perc_check judges them
     return c
+
+
+def points_check(case, r, before, after, d):
+    """A scan that ran has one samples.csv row per point of its (mutated) list."""
+    if r.rc not in (0, 1):
+        return []
+    pts = [l for l in case.files["pts.csv"].decode(errors="replace").splitlines() if l.strip() and not l.startswith("#")]
+    path = os.path.join(d, "out", "samples.csv")
+    if not os.path.exists(path):
+        return [("missing_output", "out/samples.csv")]
+    rows = open(path, "rb").read().splitlines()
+    if len(rows) != len(pts):
+        return [("points_rows", "%d rows for %d points" % (len(rows) - 1, len(pts) - 1))]
+    return []
+
+
+def gen_points(rng, i, seeds):
+    data, descs = mutate(rng, seeds.files["pts.csv"], "points")
+    argv = ["scan", "--open", "--points", "pts.csv", "--job", "rigidity", "-q", "-o", "out"]
+    return Case("points", i, argv, {"pts.csv": data}, ["pts.csv: %s" % d for d in descs], "scan", [points_check],
+                outputs=("out/samples.csv",))
 
 
 # reader slots: (name, builder(filename) -> (argv, command, extra files, expect_scene_msg, checks, outputs))
@@ -1178,7 +1204,8 @@ def gen_paths(rng, i, seeds):
 
 GENERATORS = {"network": gen_network, "scene": gen_scene, "law": gen_law, "sweep_ckpt": gen_sweep_ckpt,
               "percolation": gen_percolation, "foreign": gen_foreign,
-              "model": lambda rng, i, seeds: gen_foreign(rng, i, seeds, "model"), "paths": gen_paths}
+              "model": lambda rng, i, seeds: gen_foreign(rng, i, seeds, "model"), "paths": gen_paths,
+              "points": gen_points}
 
 
 # ----------------------------------------------------------------------------------------------------------------

@@ -114,7 +114,7 @@ struct Manifest {
             for (const auto& a : j.at("axes"))
                 m.grid.axes.push_back({a.at("name").get<std::string>(), a.at("key").get<std::string>(),
                                        a.at("values").get<std::vector<std::string>>(),
-                                       a.at("labels").get<std::vector<std::string>>(), a.value("group", -1)});
+                                       a.at("labels").get<std::vector<std::string>>(), a.value("group", -1), where});
         } catch (const nlohmann::json::exception& e) {
             throw InputError(where + ": not a scan manifest (" + e.what() + ")");
         }
@@ -138,8 +138,12 @@ std::string sample_scene(const Manifest& m, const Scene& base, std::size_t index
 
 // Every sample's scene, read back and checked as its command will check it: bad values stop the scan before any work.
 void check_samples(const Manifest& m, const Scene& base) {
+    std::string sources;  // where the values came from: --vary specs and points files
+    for (const auto& a : m.grid.axes)
+        if (!a.source.empty() && sources.find(a.source) == std::string::npos) sources += (sources.empty() ? "" : ", ") + a.source;
     for (std::size_t i = 0; i < m.grid.size(); ++i) {
-        Scene s = parse_scene(sample_scene(m, base, i), describe(m.grid, i));
+        const std::string who = describe(m.grid, i) + (sources.empty() ? "" : " of " + sources);
+        Scene s = parse_scene(sample_scene(m, base, i), who);
         s.check();
     }
 }

@@ -10,6 +10,7 @@
 
 #include "fibernet/scene/scene_toml.hpp"
 #include "fibernet/util/error.hpp"
+#include "fibernet/util/utf8.hpp"
 
 namespace fibernet {
 
@@ -30,6 +31,14 @@ std::string grid_key(const std::string& name, const std::string& where) {
 }
 
 namespace {
+// A value is printable UTF-8: a control byte (a NUL ends messages and file names) or a broken sequence is refused.
+void check_text(const std::string& t, const std::string& where) {
+    for (unsigned char c : t)
+        if (c < 0x20 || c == 0x7f) throw InputError(where + ": a value holds the control byte " + std::to_string(c));
+    const std::size_t bad = invalid_utf8_at(t);
+    if (bad != std::string::npos) throw InputError(where + ": a value is not UTF-8 (byte " + std::to_string(bad + 1) + ")");
+}
+
 bool whole_integer(const std::string& t, long long& v) {
     const char* b = t.data() + (t.size() > 1 && t[0] == '+' ? 1 : 0);
     const auto r = std::from_chars(b, t.data() + t.size(), v);
@@ -102,6 +111,7 @@ GridAxis parse_axis(const std::string& spec, const std::string& where) {
     if (eq == std::string::npos || eq == 0)
         throw InputError(where + ": --vary '" + spec + "' is not name=values (e.g. q=4,8,16 or seed=1:8)");
     GridAxis ax;
+    ax.source = "--vary " + spec;
     ax.name = spec.substr(0, eq);
     ax.key = grid_key(ax.name, where + ": --vary " + ax.name);
     const std::string rhs = spec.substr(eq + 1);
@@ -110,7 +120,8 @@ GridAxis parse_axis(const std::string& spec, const std::string& where) {
     else texts = split(rhs, ',');
     std::set<std::string> seen;
     for (const auto& t : texts) {
-        if (t.empty()) throw InputError(where + ": --vary " + spec + ": an empty value");
+        if (t.empty()) throw InputError(where + ": --vary " + ax.name + ": an empty value");
+        check_text(t, where + ": --vary " + ax.name);
         const auto [lit, label] = literal(t);
         if (!seen.insert(lit).second)
             throw InputError(where + ": --vary " + spec + ": the value " + t + " is given twice (a sample counts once)");
@@ -132,6 +143,7 @@ std::vector<GridAxis> parse_points(const std::string& text, const std::string& w
             f.erase(0, f.find_first_not_of(" \t"));
             f.erase(f.find_last_not_of(" \t") + 1);
             if (f.empty()) throw InputError(where + ":" + std::to_string(lineno) + ": an empty field");
+            check_text(f, where + ":" + std::to_string(lineno));
         }
         if (rows.size() > 1 && rows.back().size() != rows.front().size())
             throw InputError(where + ":" + std::to_string(lineno) + ": " + std::to_string(rows.back().size()) +
@@ -143,6 +155,7 @@ std::vector<GridAxis> parse_points(const std::string& text, const std::string& w
         axes[c].name = rows.front()[c];
         axes[c].key = grid_key(axes[c].name, where + ": column " + std::to_string(c + 1));
         axes[c].group = group;
+        axes[c].source = where;
     }
     std::set<std::vector<std::string>> seen;
     for (std::size_t r = 1; r < rows.size(); ++r) {

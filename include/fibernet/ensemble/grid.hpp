@@ -17,6 +17,7 @@ struct GridAxis {
     // Axes of one list of points (parse_points) share a group >= 0 and one coordinate: they vary together, the
     // k-th value of each at the k-th point. -1: an axis of its own.
     int group = -1;
+    std::string source;  // where the values came from, for messages: "--vary q=4,8" or the points file's name
 };
 
 // The scene key a name stands for: "table.key" itself, or a key's bare name where one table has it; "seed" is the
