@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -83,7 +84,8 @@ void check_row(const PercolationSample& s, int rigid, int conn, const std::strin
     if (!(std::isfinite(s.seconds) && s.seconds >= 0)) bad("seconds = " + fmt(s.seconds) + " is not a duration");
 }
 
-// Reads the rows of an existing CSV; lines that do not parse (an interrupted write) are skipped. Refuses rows that
+// Reads the rows of an existing CSV; an unterminated last line (an interrupted write) is skipped, any other line
+// that does not parse is refused. Refuses rows that
 // this run's --pl and --seed would not have made: resuming them would mix two runs. seed_of(row) is the seed the
 // base seed gives for the row's L, q and sample, where it can be known: on this run's grid, or off it (an L left out
 // on resume) when the row's L and q were written in under 10 significant digits, so their parsed values are exact
@@ -109,7 +111,15 @@ std::vector<PercolationSample> read_rows(const std::string& path, double pl, std
         PercolationSample s;
         int rigid = 0, conn = 0;
         std::uint64_t seed = 0;
-        if (!parse_row(line, s, seed, rigid, conn)) continue;
+        // An unterminated last line is a write cut short (a killed run), even where what is left parses (its last
+        // field may be cut): its sample runs again, and the line is cut off before new rows are appended.
+        if (is.peek() == std::char_traits<char>::eof() && !ends_with_newline) continue;
+        if (!parse_row(line, s, seed, rigid, conn)) {
+            // A damaged row elsewhere is not skipped: its sample would be run again and counted twice.
+            throw InputError(path + ":" + std::to_string(lineno) + ": not a percolation row (" +
+                             std::to_string(std::count(line.begin(), line.end(), ',') + 1) +
+                             " fields; each must be a whole number or a decimal as fibernet writes them)");
+        }
         const std::string at = path + ":" + std::to_string(lineno) + ": ";
         if (std::abs(s.pl - pl) > 1e-12) throw InputError(at + "pl = " + fmt(s.pl) + " differs from --pl " + fmt(pl));
         check_row(s, rigid, conn, at);
@@ -236,17 +246,24 @@ std::vector<PercolationSample> existing_rows(const PercolationOpts& o, bool& new
     return read_rows(o.out, o.pl, o.seed, seed_of, newline);
 }
 
-// Rank 0's CSV: the header on a new file, then one row per finished sample as it arrives.
+// Rank 0's CSV: the header on a new file, then one row per finished sample as it arrives. A torn last line (a write
+// cut short) is cut off first, so that no damaged row ends up between whole ones.
 struct SampleCsv {
     std::ofstream csv;
-    std::size_t written = 0;
-    SampleCsv(const std::string& path, bool new_file, bool newline) : csv(path, std::ios::app) {
+    SampleCsv(const std::string& path, bool new_file, bool newline) {
+        if (!newline) {
+            std::ifstream in(path, std::ios::binary);
+            const std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+            std::error_code ec;
+            std::filesystem::resize_file(path, all.rfind('\n') == std::string::npos ? 0 : all.rfind('\n') + 1, ec);
+            if (ec) throw InputError("command line: --out " + path + ": cannot cut its torn last line (" + ec.message() + ")");
+        }
+        csv.open(path, std::ios::app);
         if (!csv) throw InputError("command line: cannot open --out " + path + " for writing");
         if (new_file) {
             std::ifstream probe(path);
             if (probe.peek() == std::ifstream::traits_type::eof()) csv << kHeader << '\n';
         }
-        if (!newline) csv << '\n';
         csv.flush();
     }
 };

@@ -205,12 +205,27 @@ TEST_CASE("percolation command appends per sample and resumes", "[rigidity][perc
     // Without --resume an existing CSV is refused; with it only the missing samples run.
     CHECK(run(base + " --samples 5", &out) == 2);
     CHECK(out.find("--resume") != std::string::npos);
-    // An interrupted write leaves a partial last line: it is skipped and its sample run again.
+    // An interrupted write leaves a partial last line: it is cut off and its sample run again.
     { std::ofstream(csv, std::ios::app) << "1,4,6,4,123"; }
     REQUIRE(run(base + " --samples 5 --resume", &out) == 0);
-    CHECK(count_lines(csv) == 1 + 2 * 3 * 5 + 1);
+    CHECK(count_lines(csv) == 1 + 2 * 3 * 5);
     REQUIRE(run(base + " --samples 5 --resume", &out) == 0);  // nothing left to do
-    CHECK(count_lines(csv) == 1 + 2 * 3 * 5 + 1);
+    CHECK(count_lines(csv) == 1 + 2 * 3 * 5);
+    {
+        std::ifstream in(csv);
+        const std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        CHECK(all.find("1,4,6,4,123\n") == std::string::npos);
+    }
+    // A damaged row elsewhere is refused, naming its line: skipped, its sample would be counted twice.
+    {
+        std::ifstream in(csv);
+        std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        const std::size_t second = all.find('\n', all.find('\n') + 1);  // the end of the first data row
+        all.insert(second + 1, "1,4,6,0,1,2,3\n");
+        std::ofstream(csv) << all;
+    }
+    CHECK(run(base + " --samples 5 --resume", &out) == 2);
+    CHECK(out.find(":3: not a percolation row") != std::string::npos);
     CHECK(run(base + " --samples 0 --resume", &out) == 2);
     CHECK(out.find("--samples = 0") != std::string::npos);
     CHECK(run("percolation --pl 1.5 --L 4 --q-min 6 --q-max 7 --q-step 0.5 --samples 1 --out /tmp/x.csv", &out) == 2);
