@@ -9,6 +9,10 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include "common.hpp"
@@ -145,6 +149,8 @@ void check_samples(const Manifest& m, const Scene& base) {
         const std::string who = describe(m.grid, i) + (sources.empty() ? "" : " of " + sources);
         Scene s = parse_scene(sample_scene(m, base, i), who);
         s.check();
+        if (!s.network_file.empty() && !fs::is_regular_file(s.network_file))
+            throw InputError(who + ": [network].file = '" + s.network_file + "' is not a readable file");
     }
 }
 
@@ -210,6 +216,7 @@ void claim_dir(const ScanDir& d, const Manifest& m, bool resume, bool shard, con
         if (!resume && !shard)
             throw InputError("command line: -o " + d.root + " holds this scan already; add --resume to run the samples "
                              "it lacks");
+        make_dirs(d, m.sample_files || m.job == "sweep");  // work/ went at the end of the last run
         return;
     }
     make_dirs(d, m.sample_files || m.job == "sweep");
@@ -226,7 +233,24 @@ struct Tables {
     double sample_seconds = 0;
 };
 
+// Under a lock on DIR/.lock: shards of one directory that end together must not rename an older table over a newer.
+class DirLock {
+public:
+    explicit DirLock(const ScanDir& d) : fd_(::open((d.root + "/.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644)) {
+        if (fd_ < 0) throw OutputError("cannot open the lock '" + d.root + "/.lock' (" + std::strerror(errno) + ")");
+        while (::flock(fd_, LOCK_EX) != 0 && errno == EINTR) {
+        }
+    }
+    ~DirLock() { ::close(fd_); }  // closing releases the lock
+    DirLock(const DirLock&) = delete;
+    DirLock& operator=(const DirLock&) = delete;
+
+private:
+    int fd_;
+};
+
 Tables write_tables(const ScanDir& d, const Manifest& m) {
+    const DirLock lock(d);
     const JournalContents jc = read_journals(d.journal());
     std::vector<const nlohmann::json*> recs;
     Tables t;
@@ -263,6 +287,7 @@ public:
         const auto t0 = std::chrono::steady_clock::now();
         try {
             if (!journal_) journal_ = std::make_unique<JournalWriter>(dir_.journal(), tag_);
+            remove_stale_files(index);
             write_file_atomic(scene_file_, sample_scene(m_, base_, index));
             const JobOutcome o = run_job(m_.job, scene_file_, args(index));
             r.seconds = seconds_since(t0);
@@ -281,6 +306,26 @@ public:
     }
 
 private:
+    // A sample without a journal record runs from the start: what an interrupted or killed run of it left (a sweep's
+    // CSV and unfinished checkpoint, which sweep would refuse without --resume) goes first.
+    void remove_stale_files(std::size_t index) const {
+        const std::string stem = dir_.samples() + "/sample-" + std::to_string(index);
+        std::error_code ec;
+        for (const char* ext : {".csv", ".csv.ckpt", ".model", ".svg"}) fs::remove(stem + ext, ec);
+    }
+
+    // Paths inside the scan's directory, relative to it ("samples/sample-3.csv"): the rows must not depend on where
+    // the directory was when the sample ran (shards merged from elsewhere).
+    void relative_paths(nlohmann::json& j) const {
+        const std::string prefix = dir_.root + "/";
+        if (j.is_string()) {
+            const std::string& v = j.get_ref<const std::string&>();
+            if (v.rfind(prefix, 0) == 0) j = v.substr(prefix.size());
+        } else if (j.is_structured()) {
+            for (auto& el : j) relative_paths(el);
+        }
+    }
+
     std::vector<std::string> args(std::size_t index) const {
         std::vector<std::string> a = m_.job_args;
         const std::string stem = dir_.samples() + "/sample-" + std::to_string(index);
@@ -302,6 +347,7 @@ private:
             status = o.result["status"].get<std::string>();
         nlohmann::json result = o.result;
         if (result.is_object() && result.contains("scene")) result["scene"] = describe(m_.grid, index);  // not the work file
+        relative_paths(result);
         nlohmann::json j = {{"index", index}, {"params", params}, {"status", status}, {"exit_code", o.exit_code},
                             {"result", result}, {"seconds", seconds}, {"rank", rank_}, {"host", host_name()}};
         if (!o.error.empty()) j["error"] = o.error;
@@ -316,14 +362,9 @@ private:
     std::unique_ptr<JournalWriter> journal_;
 };
 
-// Journals of other directories of the same scan (shards run apart) copied into this one.
-void merge_from(const ScanDir& d, const Manifest& m, const std::vector<std::string>& sources) {
-    for (const auto& src : sources) {
-        const ScanDir s{src};
-        const Manifest theirs = Manifest::from(read_json_file(s.manifest()), s.manifest());
-        if (theirs.determining() != m.determining())
-            throw InputError("command line: --merge " + src + " holds another scan than " + d.root);
-    }
+// Journals and sample files of other directories of the same scan (shards run apart, checked by merge_scan) copied
+// into this one; what is there already is kept.
+void merge_from(const ScanDir& d, const Manifest&, const std::vector<std::string>& sources) {
     for (const auto& src : sources) {
         std::error_code ec;
         for (const auto& e : fs::directory_iterator(ScanDir{src}.journal(), ec)) {
@@ -334,6 +375,12 @@ void merge_from(const ScanDir& d, const Manifest& m, const std::vector<std::stri
             if (ec) throw OutputError("cannot copy '" + e.path().string() + "' to '" + to.string() + "' (" + ec.message() + ")");
         }
         if (ec) throw InputError("command line: --merge " + src + ": cannot read its journal (" + ec.message() + ")");
+        const fs::path samples = ScanDir{src}.samples();
+        if (fs::is_directory(samples, ec)) {
+            fs::create_directories(d.samples(), ec);
+            fs::copy(samples, d.samples(), fs::copy_options::recursive | fs::copy_options::skip_existing, ec);
+            if (ec) throw OutputError("cannot copy '" + samples.string() + "' to '" + d.samples() + "' (" + ec.message() + ")");
+        }
     }
 }
 
@@ -353,6 +400,19 @@ Scene base_scene(const SceneFlags& flags) {
     return s;
 }
 
+// The values of a varied network file or law table by absolute path (relative ones taken from the working
+// directory, as on the command line): each sample's scene is read from DIR/work/.
+void absolute_paths(GridAxis& a) {
+    if (a.key != "network.file" && a.key != "wet.law") return;
+    for (std::size_t v = 0; v < a.values.size(); ++v) {
+        std::error_code ec;
+        a.labels[v] = fs::absolute(a.labels[v], ec).lexically_normal().string();
+        std::string q = "\"";
+        for (char c : a.labels[v]) q += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+        a.values[v] = q + "\"";
+    }
+}
+
 Manifest manifest_of(const SceneFlags& flags, const Options& o, Scene& base) {
     if (o.job.empty()) throw InputError("command line: --job is required (modulus, relax, rigidity, sweep or wet)");
     Manifest m;
@@ -364,6 +424,12 @@ Manifest manifest_of(const SceneFlags& flags, const Options& o, Scene& base) {
             m.grid.axes.push_back(std::move(a));
     for (const auto& v : o.vary) m.grid.axes.push_back(parse_axis(v, "command line"));
     check_grid(m.grid, kMaxSamples, "command line");
+    for (auto& a : m.grid.axes) absolute_paths(a);
+    for (const auto& a : m.grid.axes)  // wet's --betas replaces the scene's beta: a varied beta would be ignored
+        for (const auto& arg : m.job_args)
+            if (a.key == "wet.beta" && arg.rfind("--betas", 0) == 0)
+                throw InputError("command line: --job-args " + arg + " gives each sample its own list of betas, which "
+                                 "would override --vary " + a.name + ": give one or the other");
     base = base_scene(flags);
     m.scene = to_toml(base);
     m.sample_files = o.sample_files;
@@ -406,11 +472,18 @@ int print_scene(const ScanDir& d, long long n) {
 }
 
 int merge_scan(const ScanDir& d, const std::vector<std::string>& sources) {
-    if (!fs::exists(d.manifest())) {  // a new directory: the first source's scan
-        const nlohmann::json j = read_json_file(ScanDir{sources.front()}.manifest());
-        Manifest::from(j, sources.front());
-        make_dirs(d, j.value("sample_files", false) || j.value("job", "") == "sweep");
-        write_file_atomic(d.manifest(), json_text(j, 2) + "\n");
+    // Every source checked before anything is written: the first one's scan, and the others must hold it too.
+    const nlohmann::json first = read_json_file(ScanDir{sources.front()}.manifest());
+    const Manifest m0 = Manifest::from(first, ScanDir{sources.front()}.manifest());
+    for (const auto& src : sources)
+        if (Manifest::from(read_json_file(ScanDir{src}.manifest()), ScanDir{src}.manifest()).determining() != m0.determining())
+            throw InputError("command line: --merge " + src + " holds another scan than " + sources.front());
+    if (fs::exists(d.manifest())) {
+        if (Manifest::from(read_json_file(d.manifest()), d.manifest()).determining() != m0.determining())
+            throw InputError("command line: -o " + d.root + " holds another scan than the --merge sources");
+    } else {  // a new directory: the sources' scan
+        make_dirs(d, m0.sample_files || m0.job == "sweep");
+        write_file_atomic(d.manifest(), json_text(first, 2) + "\n");
     }
     Scene base;
     const Manifest m = stored_manifest(d, base);
@@ -427,8 +500,10 @@ std::string prepare(const ScanDir& d, const Manifest& m, const Scene& base, cons
         check_samples(m, base);
         claim_dir(d, m, o.resume, !o.shard.empty(), cmdline);
         const JournalContents done = read_journals(d.journal());
-        for (std::size_t i = sh.i; i < m.grid.size(); i += sh.n)
+        for (std::size_t i = sh.i; i < m.grid.size(); i += sh.n) {
             if (!done.records.count(i)) todo.push_back(i);
+            if (m.grid.size() - i <= sh.n) break;  // i + N would pass the grid (or wrap round)
+        }
         if (!o.quiet)
             std::cerr << "scan: " << m.grid.size() << " samples of " << m.job << (sh.n > 1 ? ", shard " + sh.text() : "")
                       << ", " << todo.size() << " to run, " << (done.records.size()) << " journaled before\n";
@@ -486,10 +561,12 @@ int run_scan(const SceneFlags& flags, const Options& o, const std::vector<std::s
     const double wall = seconds_since(t0);
     comm->barrier();  // every rank's journal is complete
     end_if_not_root(comm, 0);
-    if (!out.input_error.empty()) throw InputError(out.input_error + " (the scan stopped; the samples finished before "
-                                                   "are kept, and --resume continues once the input is fixed)");
+    if (!out.input_error.empty())
+        throw InputError(out.input_error + " (the scan stopped; the samples finished before it are kept in " + d.root + ")");
     if (!out.output_error.empty()) throw OutputError(out.output_error);
     const Tables t = write_tables(d, m);
+    std::error_code ec;
+    fs::remove(d.work(), ec);  // empty once every rank's work file is gone (another shard may still use it)
     nlohmann::json j = tables_json(d, m, t);
     const double busy = queue.busy_seconds();
     j["run"] = {{"transport", comm->kind()},

@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <cmath>
 #include <csignal>
+#include <optional>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -431,7 +432,10 @@ void register_wet(CLI::App& app) {
         // write left the state held (kWriting), where hold() would wait for ever.
         g_state = kRunning, g_pending = false;
         hold();  // before the handler exists: nothing to report until checkpoint(0) has run
-        InterruptScope interrupts;
+        // Inside fibernet scan (its JSON captured) the scan's handler stays: an interrupt ends the scan after this
+        // sample, not the process in the middle of it.
+        std::optional<InterruptScope> interrupts;
+        if (!json_capture()) interrupts.emplace();
         checkpoint(0);
         release();
         for (size_t k = 0; k < betas.size(); ++k) {

@@ -61,7 +61,8 @@ const std::vector<std::string>& scan_jobs() {
 
 void check_job_args(const std::string& job, const std::vector<std::string>& args) {
     for (const auto& a : args) {
-        const std::string flag = a.substr(0, a.find('='));
+        std::string flag = a.substr(0, a.find('='));
+        if (flag.size() > 2 && flag[0] == '-' && flag[1] != '-') flag = flag.substr(0, 2);  // -oPATH is -o PATH
         if (reserved().count(flag))
             throw InputError("command line: --job-args " + a + ": a scan sets " + flag +
                              " itself (scene values come from the scene and --vary; outputs go to -o)");

@@ -98,6 +98,21 @@ private:
                     local_error = std::current_exception();
                 }
             });
+        try {
+            answer_requests(queue, mu, out, sink);
+        } catch (...) {  // stop the local thread before the exception leaves (a joinable thread would terminate)
+            queue.stop();
+            if (local.joinable()) local.join();
+            throw;
+        }
+        if (local.joinable()) local.join();
+        if (local_error) std::rethrow_exception(local_error);
+        if (!threaded_) run_local(queue, runner, threads, mu, out, sink);  // no second thread: what is left, now
+        return out;
+    }
+
+    // Answers the other ranks until each has been told that no samples are left.
+    void answer_requests(SampleQueue& queue, std::mutex& mu, DispatchOutcome& out, const ReportSink& sink) {
         int active = size_ - 1;
         while (active > 0) {
             int flag = 0;
@@ -123,10 +138,6 @@ private:
             MPI_Send(batch.data(), static_cast<int>(batch.size()), MPI_LONG_LONG, st.MPI_SOURCE, kReply, MPI_COMM_WORLD);
             if (batch.empty()) --active;
         }
-        if (local.joinable()) local.join();
-        if (local_error) std::rethrow_exception(local_error);
-        if (!threaded_) run_local(queue, runner, threads, mu, out, sink);  // no second thread: what is left, now
-        return out;
     }
 
     int rank_ = 0, size_ = 1;

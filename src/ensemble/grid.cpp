@@ -119,11 +119,14 @@ GridAxis parse_axis(const std::string& spec, const std::string& where) {
     if (rhs.find(':') != std::string::npos && rhs.find(',') == std::string::npos) texts = range_values(ax.name, rhs, where);
     else texts = split(rhs, ',');
     std::set<std::string> seen;
+    std::set<double> seen_numbers;  // 8 and 8.0 are one value
     for (const auto& t : texts) {
         if (t.empty()) throw InputError(where + ": --vary " + ax.name + ": an empty value");
         check_text(t, where + ": --vary " + ax.name);
         const auto [lit, label] = literal(t);
-        if (!seen.insert(lit).second)
+        double d = 0;
+        const bool repeated_number = number(lit, d) && !seen_numbers.insert(d).second;
+        if (!seen.insert(lit).second || repeated_number)
             throw InputError(where + ": --vary " + spec + ": the value " + t + " is given twice (a sample counts once)");
         ax.values.push_back(lit), ax.labels.push_back(label);
     }

@@ -1,6 +1,7 @@
 #include "fibernet/network/network_io.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <cerrno>
 #include <cmath>
@@ -11,8 +12,10 @@
 #include <sstream>
 #include <vector>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "fibernet/util/error.hpp"
+#include "fibernet/util/hash.hpp"
 
 namespace fibernet {
 
@@ -88,7 +91,7 @@ struct LineReader {
 }  // namespace
 
 Network read_network(std::istream& is, const std::string& source) {
-    LineReader r{is, source};
+    LineReader r{is, source, 0, {}};
     Network net;
     {
         auto ss = r.next("header 'fibernet-network 1'");
@@ -238,7 +241,17 @@ void write_file_atomic(const std::string& path, const std::string& content) {
         if (!write_all(path)) throw failed("write");
         return;
     }
-    const std::string tmp = path + ".tmp";
+    // A temporary name of this process's own (host and pid hashed, and a count): processes that write the same file
+    // at once (fibernet scan's shards in one directory) must not rename one another's half-written temporary.
+    static std::atomic<unsigned> count{0};
+    char host[256] = {};
+    gethostname(host, sizeof host - 1);
+    char tag[32];
+    std::snprintf(tag, sizeof tag, ".%08llx%u.tmp",
+                  static_cast<unsigned long long>(fnv1a_bytes(std::string(host) + "/" + std::to_string(getpid())) &
+                                                  0xffffffffull),
+                  count++);
+    const std::string tmp = path + tag;
     errno = 0;
     if (!write_all(tmp)) {
         const OutputError e = failed("write");

@@ -214,3 +214,77 @@ TEST_CASE("cli scan: a list of points with seeds", "[cli][scan]") {
     CHECK(run("scan --points " + pts + " --job modulus -q -o " + dir("points_bad")) == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("point 2 is given twice") != std::string::npos);
 }
+
+TEST_CASE("cli scan: interrupting a wet or sweep sample ends the scan cleanly, and it resumes", "[cli][scan][signal]") {
+    // wet and sweep have interrupt handlers of their own; inside a scan, wet's must not end the process mid-sample,
+    // and a sweep sample cut short must run again from the start on --resume (its unfinished checkpoint removed).
+    const std::vector<std::pair<std::string, std::string>> jobs = {
+        {"wet", "--L 2.2 --q 6 --pl 0.5 --vary seed=1:6 --job wet --job-args --no-moduli"},
+        {"sweep", "--L 3 --q 7 --scheme even --h 2.5 --vary seed=1:6 --job sweep --job-args \"--gamma-max 0.05 --step 0.01\""},
+    };
+    for (const auto& [job, args] : jobs) {
+        INFO(job);
+        const std::string d = dir("interrupt_" + job);
+        const std::string script = "set -m; " + std::string(FIBERNET_EXE) + " scan " + args + " -q -o " + d + " > " + d +
+                                   ".out 2>/dev/null & pid=$!; for i in $(seq 1 1000); do n=$(cat " + d +
+                                   "/journal/*.jsonl 2>/dev/null | wc -l); [ \"$n\" -ge 1 ] && break; sleep 0.01; done; " +
+                                   "kill -TERM $pid; wait $pid; echo $? > " + d + ".rc";
+        REQUIRE(std::system(("bash -c '" + script + "'").c_str()) >= 0);
+        CHECK(std::stoi(slurp(d + ".rc")) == 130);
+        const auto out = nlohmann::json::parse(slurp(d + ".out"));  // the scan's JSON, not the job's
+        CHECK(out["run"]["interrupted"] == true);
+        CHECK(std::filesystem::exists(d + "/samples.csv"));
+        const int rc = run("scan " + args + " -q --resume -o " + d);
+        CHECK((rc == 0 || rc == 1));  // 1: a sample's own solve failed (its row says so)
+        CHECK(nlohmann::json::parse(slurp(tmpdir() + "/stdout"))["complete"] == true);
+        CHECK(lines(slurp(d + "/samples.csv")).size() == 7);
+    }
+}
+
+TEST_CASE("cli scan: shards in one directory at once, and shards of sweeps merged, give one run's rows", "[cli][scan]") {
+    const std::string ref = slurp(reference() + "/samples.csv");
+    for (int trial = 0; trial < 3; ++trial) {
+        const std::string d = dir("together" + std::to_string(trial));
+        std::string script;
+        for (int i = 0; i < 4; ++i)
+            script += std::string(FIBERNET_EXE) + " scan " + kGrid + " --shard " + std::to_string(i) + "/4 -o " + d +
+                      " > /dev/null 2>&1 & p" + std::to_string(i) + "=$!; ";
+        script += "r=0; for p in $p0 $p1 $p2 $p3; do wait $p || r=1; done; exit $r";
+        CHECK(WEXITSTATUS(std::system(("bash -c '" + script + "'").c_str())) == 0);
+        CHECK(slurp(d + "/samples.csv") == ref);
+    }
+    const std::string sweep = "--L 3 --q 7 --scheme even --h 2.5 --vary seed=1:3 --job sweep --job-args "
+                              "\"--gamma-max 0.02 --step 0.01\" -q";
+    const std::string one = dir("sweep_one"), a = dir("sweep_a"), b = dir("sweep_b"), m = dir("sweep_merged");
+    REQUIRE(run("scan " + sweep + " -o " + one) == 0);
+    REQUIRE(run("scan " + sweep + " --shard 0/2 -o " + a) == 0);
+    REQUIRE(run("scan " + sweep + " --shard 1/2 -o " + b) == 0);
+    REQUIRE(run("scan --merge " + a + " " + b + " -o " + m) == 0);
+    CHECK(slurp(m + "/samples.csv") == slurp(one + "/samples.csv"));
+    CHECK(slurp(one + "/samples.csv").find(",samples/sample-1.csv,") != std::string::npos);
+    const auto merged_table = lines(slurp(m + "/samples/sample-1.csv")), own = lines(slurp(one + "/samples/sample-1.csv"));
+    REQUIRE(merged_table.size() == own.size());  // the sweep's table came along (its last column is wall time)
+    for (std::size_t k = 1; k < own.size(); ++k)
+        CHECK(merged_table[k].substr(0, merged_table[k].rfind(',')) == own[k].substr(0, own[k].rfind(',')));
+}
+
+TEST_CASE("cli scan: more bad input, refused before anything is written", "[cli][scan][input]") {
+    const std::string d = dir("bad2");
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"--vary network.file=/nonexistent.net --job modulus", "'/nonexistent.net' is not a readable file"},
+        {"--vary q=8,8.0 --job modulus", "8.0 is given twice"},
+        {"--vary seed=1:2 --job relax --job-args -o/tmp/x.model", "a scan sets -o itself"},
+        {"--vary beta=0,1 --job wet --job-args --betas=0.5", "would override --vary beta"},
+    };
+    for (const auto& [args, says] : cases) {
+        INFO(args);
+        CHECK(run("scan --L 3 " + args + " -o " + d) == 2);
+        CHECK(slurp(tmpdir() + "/stderr").find(says) != std::string::npos);
+        CHECK(!std::filesystem::exists(d));
+    }
+    CHECK(run("scan --merge " + reference() + " " + tmpdir() + "/nonexistent -o " + d) == 2);
+    CHECK(!std::filesystem::exists(d));
+    // A shard count past the grid: shard 1 has sample 1 only.
+    REQUIRE(run("scan " + kGrid + " --shard 1/18446744073709551615 -o " + d) == 0);
+    CHECK(lines(slurp(d + "/samples.csv")).size() == 2);
+}

@@ -56,6 +56,7 @@ TEST_CASE("grid: bad specifications name the value", "[ensemble]") {
     CHECK(message_of("density=1,2").find("'density' is not a scene key") != std::string::npos);
     CHECK(message_of("q=4,,8").find("an empty value") != std::string::npos);
     CHECK(message_of("q=4,8,4").find("the value 4 is given twice") != std::string::npos);
+    CHECK(message_of("q=8,8.0").find("the value 8.0 is given twice") != std::string::npos);
     CHECK(message_of("seed=5:1").find("last 1 is below first 5") != std::string::npos);
     CHECK(message_of("q=1:2.5").find("takes integers") != std::string::npos);
     CHECK(message_of("q=1:2:0").find("step '0'") != std::string::npos);
