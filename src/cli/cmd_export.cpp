@@ -14,7 +14,9 @@ void register_export(CLI::App& app) {
     auto out = std::make_shared<std::string>();
     flags->add(cmd, false);
     cmd->add_option("-o,--output", *out, "model file to write (default: standard output)");
-    cmd->callback([flags, out] {
+    auto quiet = std::make_shared<bool>(false);
+    cmd->add_flag("-q,--quiet", *quiet, "no statistics on stderr");
+    cmd->callback([flags, out, quiet] {
         Scene s = flags->resolve();
         Network net = scene_network(s);
         Model m = discretize(net, s.discretization);
@@ -22,7 +24,7 @@ void register_export(CLI::App& app) {
         write_model(os, m);
         if (out->empty()) std::cout << os.str();
         else write_file_atomic(*out, os.str());
-        std::cerr << json_text(to_json(summarize(m))) << "\n";
+        if (!*quiet) std::cerr << json_text(to_json(summarize(m))) << "\n";
     });
 }
 

@@ -13,7 +13,9 @@ void register_generate(CLI::App& app) {
     auto out = std::make_shared<std::string>();
     flags->add(cmd, false);
     cmd->add_option("-o,--output", *out, "network file to write (default: standard output)");
-    cmd->callback([flags, out] {
+    auto quiet = std::make_shared<bool>(false);
+    cmd->add_flag("-q,--quiet", *quiet, "no statistics on stderr");
+    cmd->callback([flags, out, quiet] {
         Scene s = flags->resolve();
         const auto t0 = std::chrono::steady_clock::now();
         Network net = scene_network(s);
@@ -22,7 +24,7 @@ void register_generate(CLI::App& app) {
         else save_network(net, *out);
         nlohmann::json j = to_json(statistics(net));
         j["generation_seconds"] = t;
-        std::cerr << json_text(j) << "\n";
+        if (!*quiet) std::cerr << json_text(j) << "\n";
     });
 }
 

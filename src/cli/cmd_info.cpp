@@ -9,6 +9,7 @@ void register_info(CLI::App& app) {
     auto* cmd = app.add_subcommand("info", "print network statistics and the model summary (JSON)");
     auto flags = std::make_shared<SceneFlags>();
     flags->add(cmd, false);
+    cmd->add_flag("-q,--quiet", "accepted by every command; this one prints nothing on stderr but errors");
     cmd->callback([flags] {
         Scene s = flags->resolve();
         auto t0 = std::chrono::steady_clock::now();

@@ -41,6 +41,7 @@ void register_rigidity(CLI::App& app) {
                                                "clamp degrees of freedom d and spanning (JSON)");
     auto flags = std::make_shared<SceneFlags>();
     flags->add(cmd, false);
+    cmd->add_flag("-q,--quiet", "accepted by every command; this one prints nothing on stderr but errors");
     auto svg = std::make_shared<std::string>();
     auto out = std::make_shared<std::string>();
     auto no_clamps = std::make_shared<bool>(false);

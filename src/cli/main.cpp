@@ -11,7 +11,7 @@
 
 int main(int argc, char** argv) {
     using namespace fibernet;
-    CLI::App app{"fibernet: mechanics of random fiber networks by implicit energy minimization"};
+    CLI::App app{"fibernet: mechanics of random fiber networks by implicit energy minimization", "fibernet"};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("fibernet ") + FIBERNET_VERSION + " (" + FIBERNET_GIT_COMMIT + ")");
     cli::register_generate(app);
@@ -26,6 +26,10 @@ int main(int argc, char** argv) {
     cli::register_sweep(app);
     cli::register_scan(app);
     for (int i = 1; i < argc; ++i) cli::command_argv().push_back(argv[i]);
+    if (argc == 1) {  // nothing asked: the usage, as an input error (CLI11 alone says only "A subcommand is required")
+        std::cerr << app.help() << "\nfibernet: error: give a command (fibernet <command> --help for its flags)\n";
+        return 2;
+    }
     try {
         (void)thread_count();  // a bad FIBERNET_THREADS is an input error before any work
         // CLI11 says only "A subcommand is required" for a word that names none: name it and the commands.

@@ -105,3 +105,18 @@ TEST_CASE("cli: paths that are not UTF-8 are used as given and echoed with U+FFF
     CHECK(run("sweep --network '" + d + "/n.net' --scheme even --gamma-max 0.02 -q -o '" + d + "/sw.csv'") == 0);
     CHECK(run("sweep --network '" + d + "/n.net' --scheme even --gamma-max 0.02 -q --resume -o '" + d + "/sw.csv'") == 0);
 }
+
+TEST_CASE("cli: bare fibernet prints the usage, and every command takes -q", "[cli]") {
+    CHECK(run("") == 2);
+    const std::string err = slurp(tmpdir() + "/stderr");
+    CHECK(err.find("Usage: fibernet") != std::string::npos);
+    CHECK(err.find("scan") != std::string::npos);
+    CHECK(slurp(tmpdir() + "/stdout").empty());
+    // generate and export print statistics on stderr; -q silences them. The others take it too.
+    for (const std::string c : {"generate --L 3", "export --L 3", "info --L 3", "rigidity --L 3 --open",
+                                "modulus --L 3", "relax --L 3"}) {
+        INFO(c);
+        CHECK(run(c + " -q") == 0);
+        CHECK(slurp(tmpdir() + "/stderr").empty());
+    }
+}
