@@ -515,23 +515,6 @@ std::string prepare(const ScanDir& d, const Manifest& m, const Scene& base, cons
     }
 }
 
-struct SignalGuard {
-    struct sigaction old_int {}, old_term {};
-    SignalGuard() {
-        struct sigaction sa {};
-        sa.sa_handler = on_scan_signal;
-        sigemptyset(&sa.sa_mask);
-        sigaction(SIGINT, nullptr, &old_int);
-        sigaction(SIGTERM, nullptr, &old_term);
-        if (old_int.sa_handler != SIG_IGN) sigaction(SIGINT, &sa, nullptr);  // an ignored SIGINT stays ignored
-        if (old_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &sa, nullptr);
-    }
-    ~SignalGuard() {
-        sigaction(SIGINT, &old_int, nullptr);
-        sigaction(SIGTERM, &old_term, nullptr);
-    }
-};
-
 int run_scan(const SceneFlags& flags, const Options& o, const std::vector<std::string>& argv) {
     const ScanDir d{o.out};
     const Shard sh = parse_shard(o.shard);
@@ -547,7 +530,7 @@ int run_scan(const SceneFlags& flags, const Options& o, const std::vector<std::s
     }
     one_thread_per_sample();
     g_interrupts = 0;
-    SignalGuard signals;
+    const SignalScope signals(on_scan_signal);
     SampleQueue queue(std::move(todo), o.quiet ? -1.0 : 2.0);
     const auto t0 = std::chrono::steady_clock::now();
     DispatchOutcome out;

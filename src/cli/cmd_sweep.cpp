@@ -287,16 +287,11 @@ void register_sweep(CLI::App& app) {
         };
         // Ctrl-C and SIGTERM end the sweep after the step in progress, unless the caller ignores them (a background
         // job of a script inherits SIGINT ignored): that disposition is kept.
-        struct sigaction stop_sa {}, old_int {}, old_term {};
-        stop_sa.sa_handler = on_signal;
-        sigemptyset(&stop_sa.sa_mask);
-        sigaction(SIGINT, nullptr, &old_int);
-        sigaction(SIGTERM, nullptr, &old_term);
-        if (old_int.sa_handler != SIG_IGN) sigaction(SIGINT, &stop_sa, nullptr);
-        if (old_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &stop_sa, nullptr);
-        const SweepOutcome o = run_sweep(e, *p, *solver, cb, *resume ? &start : nullptr, snap.get());
-        sigaction(SIGINT, &old_int, nullptr);
-        sigaction(SIGTERM, &old_term, nullptr);
+        SweepOutcome o;
+        {
+            const SignalScope signals(on_signal);
+            o = run_sweep(e, *p, *solver, cb, *resume ? &start : nullptr, snap.get());
+        }
         if (o.completed && rows > 0) write_checkpoint(*ckpt, params, rows, last, true);
         // A sweep that failed before its first row (the reference state's linear response) leaves no files: a CSV
         // of its header alone would read as a sweep with no steps.

@@ -224,6 +224,21 @@ void flush_stdout() {
                           (errno ? std::strerror(errno) : "the write failed") + ")");
 }
 
+SignalScope::SignalScope(void (*handler)(int)) {
+    struct sigaction sa {};
+    sa.sa_handler = handler;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, nullptr, &old_int_);
+    sigaction(SIGTERM, nullptr, &old_term_);
+    if (old_int_.sa_handler != SIG_IGN) sigaction(SIGINT, &sa, nullptr);
+    if (old_term_.sa_handler != SIG_IGN) sigaction(SIGTERM, &sa, nullptr);
+}
+
+SignalScope::~SignalScope() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+}
+
 std::vector<std::string>& command_argv() {
     static std::vector<std::string> argv;
     return argv;

@@ -2,6 +2,7 @@
 // Shared pieces of the `fibernet` subcommands: the scene flags every command accepts, JSON output, output files.
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <csignal>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -88,6 +89,20 @@ double seconds_since(const std::chrono::steady_clock::time_point& t0);
 
 // The command line as given (without the program name), set by main: recorded in results for provenance.
 std::vector<std::string>& command_argv();
+
+// SIGINT and SIGTERM go to `handler` for the scope's life, unless the process started with one ignored (a shell
+// script's background job gets SIGINT so: Ctrl-C meant for the script must not stop it); the previous
+// dispositions come back at the end. Used by sweep and scan (wet has its own: it exits on SIGTERM whatever).
+class SignalScope {
+public:
+    explicit SignalScope(void (*handler)(int));
+    ~SignalScope();
+    SignalScope(const SignalScope&) = delete;
+    SignalScope& operator=(const SignalScope&) = delete;
+
+private:
+    struct sigaction old_int_ {}, old_term_ {};
+};
 
 // Process exit code a command sets when its computation did not succeed (1); main returns it.
 int& exit_code();
