@@ -364,7 +364,7 @@ private:
 
 // Journals and sample files of other directories of the same scan (shards run apart, checked by merge_scan) copied
 // into this one; what is there already is kept.
-void merge_from(const ScanDir& d, const Manifest&, const std::vector<std::string>& sources) {
+void merge_from(const ScanDir& d, const std::vector<std::string>& sources) {
     for (const auto& src : sources) {
         std::error_code ec;
         for (const auto& e : fs::directory_iterator(ScanDir{src}.journal(), ec)) {
@@ -487,7 +487,7 @@ int merge_scan(const ScanDir& d, const std::vector<std::string>& sources) {
     }
     Scene base;
     const Manifest m = stored_manifest(d, base);
-    merge_from(d, m, sources);
+    merge_from(d, sources);
     const Tables t = write_tables(d, m);
     emit_json(tables_json(d, m, t));
     return t.failed > 0 ? 1 : 0;

@@ -19,13 +19,23 @@ const std::map<std::string, Registrar>& registrars() {
     return r;
 }
 
-// Arguments a scan sets itself: the scene (its values come from the scene file and the grid) and the outputs.
+// Arguments a scan sets itself: the scene flags (taken from SceneFlags::add, their one declaration; their values come
+// from the scene file and the grid), wet's [wet] overrides, and the outputs.
 const std::set<std::string>& reserved() {
-    static const std::set<std::string> r = {
-        "--network", "--L", "--q", "--pl", "--seed", "--open", "--scheme", "--nseg", "--h", "--a", "--prune", "--gamma",
-        "--strain", "--solver", "--tol", "--max-iter", "--beta", "--law", "--crossings", "--fraction", "--wet-seed",
-        "--bundle-partners", "--free-box", "--free-box-shape", "--free-box-tol", "-o", "--out", "--out-dir",
-        "--output", "--svg", "--table", "--summary", "--checkpoint", "--resume", "-v", "--verbose", "-q", "--quiet"};
+    static const std::set<std::string> r = [] {
+        std::set<std::string> names = {"--beta", "--law", "--crossings", "--fraction", "--wet-seed", "--bundle-partners",
+                                       "--free-box", "--free-box-shape", "--free-box-tol", "-o", "--out", "--out-dir",
+                                       "--output", "--svg", "--table", "--summary", "--checkpoint", "--resume", "-v",
+                                       "--verbose", "-q", "--quiet"};
+        CLI::App app;
+        SceneFlags flags;
+        flags.add(app.add_subcommand("any"), true);
+        for (const CLI::Option* o : flags.opts) {
+            for (const auto& l : o->get_lnames()) names.insert("--" + l);
+            for (const auto& sn : o->get_snames()) names.insert("-" + sn);
+        }
+        return names;
+    }();
     return r;
 }
 

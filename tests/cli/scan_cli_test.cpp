@@ -38,6 +38,16 @@ const std::string& reference() {
     return d;
 }
 
+// Each case (arguments, what the message must say) exits 2 with that message and leaves no directory d.
+void check_refused(const std::vector<std::pair<std::string, std::string>>& cases, const std::string& d) {
+    for (const auto& [args, says] : cases) {
+        INFO(args);
+        CHECK(run("scan --L 3 " + args + " -o " + d) == 2);
+        CHECK(slurp(tmpdir() + "/stderr").find(says) != std::string::npos);
+        CHECK(!std::filesystem::exists(d));
+    }
+}
+
 int journal_records(const std::string& d) {
     int n = 0;
     for (const auto& e : std::filesystem::directory_iterator(d + "/journal")) n += static_cast<int>(lines(slurp(e.path())).size());
@@ -166,12 +176,7 @@ TEST_CASE("cli scan: bad grids, jobs and arguments exit 2 before any work and le
         {"--vary q=4 --job modulus --shard x", "is not i/N"},
         {"--vary q=4 --vary network.q=5 --job modulus", "varied twice"},
     };
-    for (const auto& [args, says] : cases) {
-        INFO(args);
-        CHECK(run("scan --L 3 " + args + " -o " + d) == 2);
-        CHECK(slurp(tmpdir() + "/stderr").find(says) != std::string::npos);
-        CHECK(!std::filesystem::exists(d));
-    }
+    check_refused(cases, d);
 }
 
 TEST_CASE("cli scan: every job, two samples each in one process", "[cli][scan]") {
@@ -276,12 +281,7 @@ TEST_CASE("cli scan: more bad input, refused before anything is written", "[cli]
         {"--vary seed=1:2 --job relax --job-args -o/tmp/x.model", "a scan sets -o itself"},
         {"--vary beta=0,1 --job wet --job-args --betas=0.5", "would override --vary beta"},
     };
-    for (const auto& [args, says] : cases) {
-        INFO(args);
-        CHECK(run("scan --L 3 " + args + " -o " + d) == 2);
-        CHECK(slurp(tmpdir() + "/stderr").find(says) != std::string::npos);
-        CHECK(!std::filesystem::exists(d));
-    }
+    check_refused(cases, d);
     CHECK(run("scan --merge " + reference() + " " + tmpdir() + "/nonexistent -o " + d) == 2);
     CHECK(!std::filesystem::exists(d));
     // A shard count past the grid: shard 1 has sample 1 only.
