@@ -13,8 +13,8 @@ Formats (--formats, comma-separated; default all):
               rising, a completed sweep ends at gamma_max, JSON rows == CSV rows
   percolation percolation sample CSVs through `fibernet percolation --resume`; the result is checked: header kept, no
               duplicate (L, q, sample), every sample present, d/rigid/connected consistent, P in [0, 1]
-  model       model files (`fibernet export` / `relax -o`). The CLI has no model reader (read_model is library-only),
-              so mutated model files are fed to every reader slot as a wrong file, as in `foreign`
+  model       model files (`fibernet export` / `relax -o`) through `fibernet export --model FILE` (--format vtp and
+              lammps), and fed to every other reader slot as a wrong file, as in `foreign`
   foreign     every seed file (and empty, binary, UTF-16, BOM, directory, /dev/null inputs) in every reader slot: the
               positional scene (a non-scene file there must get a message that says so), --network, --law, a sweep
               checkpoint, a percolation CSV
@@ -57,7 +57,7 @@ FORMATS = ["network", "scene", "law", "sweep_ckpt", "percolation", "model", "for
 DEFAULT_SEED = 20261201
 TINY = ["--L", "2.5", "--q", "4"]
 
-SWEEP_HEADER = (b"step,gamma,sigma_xx,sigma_xy,sigma_yy,stress_path,K,K_affine,energy,stretch,bend,iterations,"
+SWEEP_HEADER = (b"step,gamma,sigma_xx,sigma_xy,sigma_yy,stress_path,dsdgamma,dsdgamma_affine,energy,stretch,bend,iterations,"
                 b"factorizations,retries,grad_max,seconds")
 PERC_HEADER = b"pl,L,q,sample,seed,fibers,d,rigid_spanning,connected_spanning,seconds"
 PERC_ARGS = ["--pl", "1", "--L", "3", "--q-min", "5", "--q-max", "6", "--q-step", "0.5", "--samples", "2",
@@ -1076,6 +1076,10 @@ def slot_defs(seeds):
                                  {"c.ckpt": seeds.files["part_ckpt"]}, False, [], ())),
         ("csv:percolation", lambda f: (["percolation"] + PERC_ARGS + ["--out", f, "--resume"], "percolation", {}, False,
                                        [], ())),
+        ("model:export-vtp", lambda f: (["export", "--model", f, "--format", "vtp", "-q", "-o", "out/s.vtp"], "export",
+                                        {}, False, [], ())),
+        ("model:export-lammps", lambda f: (["export", "--model", f, "--format", "lammps", "-q", "-o", "out/l"],
+                                           "export", {}, False, [], ())),
     ]
 
 

@@ -7,7 +7,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 pkgs=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libopenblas-dev
       libnlopt-cxx-dev coinor-libipopt-dev catch2 libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
-      openmpi-bin libopenmpi-dev python3-matplotlib)  # MPI: fibernet scan; matplotlib: the plot scripts
+      openmpi-bin libopenmpi-dev python3-matplotlib  # MPI: fibernet scan; matplotlib: the plot scripts
+      pybind11-dev python3-dev python3-numpy)          # the Python package (docs/python.md)
+# The test suite also runs LAMMPS and VTK on fibernet's exports, and pytest on the Python package.
+test_pkgs=(lammps python3-vtk9 python3-pytest)
+[ "${1:-}" = "--all" ] && pkgs+=("${test_pkgs[@]}")
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -29,4 +33,8 @@ if [ "$mode" = "--all" ]; then
   cmake --build build -j"$(nproc)" >&2
 else
   cmake --build build -j"$(nproc)" --target fibernet >&2
+  # The Python package too, where pybind11 was found (PYTHONPATH=build/python; docs/python.md).
+  if cmake --build build --target help 2>/dev/null | grep -q "_fibernet"; then
+    cmake --build build -j"$(nproc)" --target _fibernet >&2
+  fi
 fi

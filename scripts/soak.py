@@ -47,7 +47,7 @@ from fibernet_runs import child_env, child_limits, parse_json
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEFAULT_SEED = 20261201
 COMMANDS = ["modulus", "sweep", "wet"]
-SWEEP_HEADER = ("step,gamma,sigma_xx,sigma_xy,sigma_yy,stress_path,K,K_affine,energy,stretch,bend,iterations,"
+SWEEP_HEADER = ("step,gamma,sigma_xx,sigma_xy,sigma_yy,stress_path,dsdgamma,dsdgamma_affine,energy,stretch,bend,iterations,"
                 "factorizations,retries,grad_max,seconds")
 GAMMA_MAX = 0.02
 BETAS = [0.0, 0.1]

@@ -199,7 +199,8 @@ void check_opts(const PercolationOpts& o) {
     check_value((o.q_max - o.q_min) / o.q_step <= 10000, o.q_step, w, "--q-step", "gives more than 10000 densities");
     check_value(o.samples >= 1 && o.samples <= 1000000, o.samples, w, "--samples", "must lie in [1, 1e6]");
     check_value(o.threads >= 1 && o.threads <= 256, o.threads, w, "--threads", "must lie in [1, 256]");
-    check_outputs({{"--out", o.out}, {"--table", o.table}, {"--summary", o.summary}});
+    check_outputs({{"--out", o.out}, {"--table", o.table}, {"--summary", o.summary}, {"--out (sidecar)", o.out + ".json"},
+                   {"--table (sidecar)", o.table.empty() ? "" : o.table + ".json"}});
 }
 
 int density_count(const PercolationOpts& o) {
@@ -318,7 +319,22 @@ void summarize(const PercolationOpts& opts, const std::vector<PercolationSample>
         per_L.push_back({{"L", L}, {"samples", samples}, {"densities", qs.size()}, {"rigid", fit_json(fr)},
                          {"connected", fit_json(fc)}});
     }
-    if (!o->table.empty()) write_file_atomic(o->table, table.str());
+    const nlohmann::json params = {{"pl", o->pl},          {"L", o->L},         {"q_min", o->q_min},
+                                   {"q_max", o->q_max},    {"q_step", o->q_step}, {"samples", o->samples},
+                                   {"seed", o->seed}};
+    write_csv_sidecar(o->out, params,
+                      {{"pl", "crosslink probability"}, {"L", "box side (fiber lengths)"}, {"q", "density N lf^2 / A"},
+                       {"sample", "sample index at (L, q)"}, {"seed", "the sample's network seed (hashed)"},
+                       {"fibers", "fibers in the box"}, {"d", "top clamp's degrees of freedom, bottom held (0..3)"},
+                       {"rigid_spanning", "1 if d = 0"}, {"connected_spanning", "1 if the clamps are joined by pins"},
+                       {"seconds", "wall time of the sample"}});
+    if (!o->table.empty()) {
+        write_file_atomic(o->table, table.str());
+        write_csv_sidecar(o->table, params,
+                          {{"pl", "crosslink probability"}, {"L", "box side (fiber lengths)"},
+                           {"q", "density N lf^2 / A"}, {"samples", "samples at (L, q)"},
+                           {"P_rigid", "fraction rigidly spanning"}, {"P_connected", "fraction connected spanning"}});
+    }
     // nu from the probit widths, width(L) = c L^(-1/nu), then q_c with nu held there (docs/rigidity.md).
     const WidthScalingFit width_r = fit_width_scaling(Lr, wr, wer), width_c = fit_width_scaling(Lc, wc, wec);
     double cpu = 0;

@@ -50,7 +50,7 @@ void register_relax(CLI::App& app) {
             st = stress_json(stress(e, eq.q, F));
             if (!out->empty()) {
                 std::ostringstream os;
-                write_model(os, m, e.positions(eq.q, F), F);
+                write_model(os, m, e.displacements(eq.q, F), F);
                 write_file_atomic(*out, os.str());
             }
         } else {

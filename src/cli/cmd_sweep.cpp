@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "vtk_series.hpp"
 #include "fibernet/mechanics/sweep.hpp"
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/util/error.hpp"
@@ -28,9 +29,29 @@ std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop = true; }
 
 const char* kHeader =
-    "step,gamma,sigma_xx,sigma_xy,sigma_yy,stress_path,K,K_affine,energy,stretch,bend,iterations,factorizations,"
+    "step,gamma,sigma_xx,sigma_xy,sigma_yy,stress_path,dsdgamma,dsdgamma_affine,energy,stretch,bend,iterations,factorizations,"
     "retries,grad_max,seconds";
 constexpr size_t kColumns = 16;
+
+// The CSV's columns, for its sidecar (docs/sweep.md).
+nlohmann::json column_docs() {
+    return {{"step", "accepted step, 0 = the reference"},
+            {"gamma", "strain parameter t of F(t) = I + t dF"},
+            {"sigma_xx", "Cauchy stress (energy / length^2)"},
+            {"sigma_xy", "Cauchy stress (energy / length^2)"},
+            {"sigma_yy", "Cauchy stress (energy / length^2)"},
+            {"stress_path", "s = (1/A0) dE/dt (energy / length^2); sigma_xy for simple shear"},
+            {"dsdgamma", "differential modulus ds/dt, exact (linear response; energy / length^2)"},
+            {"dsdgamma_affine", "affine part of ds/dt, (1/A0) E_tt"},
+            {"energy", "total energy (bending units)"},
+            {"stretch", "stretching energy"},
+            {"bend", "bending energy"},
+            {"iterations", "solver iterations of the step"},
+            {"factorizations", "Hessian factorizations of the step"},
+            {"retries", "halved steps before this one was accepted"},
+            {"grad_max", "max |gradient| at the accepted state"},
+            {"seconds", "wall time of the step"}};
+}
 
 std::string csv_row(const SweepRow& r) {
     std::ostringstream os;
@@ -171,11 +192,13 @@ Checkpoint read_checkpoint(const std::string& path, const nlohmann::json& params
 
 // Keeps the header and the first `rows` data rows (a row written after the last checkpoint is dropped), once they
 // are what this sweep wrote: its header, steps 0, 1, ... in order, and the last one at the checkpoint's strain t.
-void truncate_csv(const std::string& path, int rows, double t) {
+// Returns the (step, gamma) of the rows kept.
+std::vector<std::pair<int, double>> truncate_csv(const std::string& path, int rows, double t) {
     std::ifstream is(path);
     if (!is) throw InputError("--resume: output '" + path + "' cannot be opened");
     auto fail = [&](const std::string& m) { throw InputError("--resume: '" + path + "': " + m); };
     std::string line, kept;
+    std::vector<std::pair<int, double>> steps;
     if (!std::getline(is, line) || line != kHeader) fail("line 1 is not the sweep's CSV header");
     kept = line + "\n";
     for (int n = 0; n < rows; ++n) {
@@ -195,8 +218,10 @@ void truncate_csv(const std::string& path, int rows, double t) {
         if (n + 1 == rows && gamma != t)  // 17 digits: the value round-trips exactly
             fail("row " + std::to_string(rows) + " has gamma '" + f[1] + "', the checkpoint's t = " + show(t));
         kept += line + "\n";
+        steps.push_back({n, gamma});
     }
     write_file_atomic(path, kept);
+    return steps;
 }
 }  // namespace
 
@@ -209,6 +234,7 @@ void register_sweep(CLI::App& app) {
     auto ckpt = std::make_shared<std::string>();
     auto resume = std::make_shared<bool>(false);
     auto quiet = std::make_shared<bool>(false);
+    auto vtk = std::make_shared<std::string>();
     cmd->add_option("--gamma-max", p->t_max, "final strain (negative: compression)")->required();
     cmd->add_option("--step", p->step, "first step (default 0.01)");
     cmd->add_option("--min-step", p->min_step, "smallest step before giving up (default 1e-6)");
@@ -219,6 +245,8 @@ void register_sweep(CLI::App& app) {
                     "checkpoint file (default OUTPUT.ckpt); one of an interrupted or failed sweep needs --resume");
     cmd->add_flag("--resume", *resume, "continue an interrupted sweep from its checkpoint (same parameters only)");
     cmd->add_flag("-q,--quiet", *quiet, "no progress lines on stderr");
+    cmd->add_option("--vtk", *vtk, "also write each step's state to DIR/step_<n>.vtp and the series to DIR/series.pvd "
+                                   "(ParaView; docs/formats.md)");
     // A sweep's strain comes from --gamma-max: hide the scene flag --gamma (kept registered, so that giving it
     // still gets the message below rather than CLI11's "not expected").
     cmd->get_option("--gamma")->group("");
@@ -231,7 +259,7 @@ void register_sweep(CLI::App& app) {
         p->kind = s.strain;
         p->check("command line");
         if (ckpt->empty()) *ckpt = *out + ".ckpt";
-        check_outputs({{"-o", *out}, {"--checkpoint", *ckpt}});
+        check_outputs({{"-o", *out}, {"--checkpoint", *ckpt}, {"-o (sidecar)", *out + ".json"}});
         std::error_code ec;
         if (!*resume && std::filesystem::is_regular_file(*ckpt, ec) && !completed_checkpoint(*ckpt))
             throw InputError("command line: --checkpoint '" + *ckpt +
@@ -252,18 +280,22 @@ void register_sweep(CLI::App& app) {
 
         int rows = 0;
         const SweepState& start = c.state;
+        VtkSeries series(*vtk);
         if (*resume) {
             if (c.dofs != e.num_dofs())
                 throw InputError(*ckpt + ": dofs = " + std::to_string(c.dofs) + " differs from this model's " +
                                  std::to_string(e.num_dofs()));
             rows = c.rows;
-            truncate_csv(*out, rows, start.t);
+            const auto kept = truncate_csv(*out, rows, start.t);
+            if (series.on()) series.open(rows - 1, kept);
             if (!*quiet)
                 std::cerr << (c.completed ? "sweep: the checkpoint's sweep is complete; nothing to add\n"
                                           : "sweep: resuming at step " + std::to_string(start.step) + ", gamma = " +
                                                 show(start.t) + "\n");
         } else {
+            if (series.on()) series.open(-1, {});
             write_file_atomic(*out, std::string(kHeader) + "\n");
+            write_csv_sidecar(*out, params, column_docs());
             std::remove(ckpt->c_str());  // a completed sweep's checkpoint must not outlive a new run that fails early
         }
         std::ofstream csv(*out, std::ios::app);
@@ -272,18 +304,35 @@ void register_sweep(CLI::App& app) {
         cb.stop = &g_stop;
         SweepState last = start;
         nlohmann::json last_step = nullptr;  // the last row written by this run, for summaries (fibernet scan)
+        // The time left if the rest of the strain goes at this run's mean pace so far (rearrangements make it a guess).
+        const auto t_run = std::chrono::steady_clock::now();
+        const double t_first = start.t;
+        auto eta = [&](double t) -> std::string {
+            const double done = std::abs(t - t_first), left = std::abs(p->t_max - t);
+            if (done <= 0 || left <= 0) return "";
+            std::ostringstream os;
+            os.precision(2);
+            os << "  ETA " << std::fixed << seconds_since(t_run) * left / done << " s";
+            return os.str();
+        };
         cb.on_step = [&](const SweepRow& r, const SweepState& st) {
             last_step = {{"step", r.step},       {"gamma", r.t},          {"sigma_xx", r.sigma(0, 0)},
                          {"sigma_xy", r.sigma(0, 1)}, {"sigma_yy", r.sigma(1, 1)}, {"stress_path", r.stress_path},
-                         {"K", r.K},             {"K_affine", r.K_affine}, {"energy", r.energy}};
+                         {"dsdgamma", r.K},      {"dsdgamma_affine", r.K_affine}, {"energy", r.energy}};
             csv << csv_row(r) << '\n' << std::flush;
             if (!csv) throw OutputError("cannot append step " + std::to_string(r.step) + " to '" + *out + "'");
+            if (series.on())
+                series.add(r.step, r.t, e, st.q, deformation(p->kind, r.t),
+                           {{}, {{"gamma", r.t}, {"stress_path", r.stress_path}, {"dsdgamma", r.K}, {"energy", r.energy}}});
             write_checkpoint(*ckpt, params, ++rows, st);
             last = st;
-            if (!*quiet)
-                std::cerr << "sweep: step " << r.step << "  gamma = " << r.t << "  s = " << r.stress_path
-                          << "  K = " << r.K << "  iterations = " << r.iterations << "  retries = " << r.retries
-                          << "  " << r.seconds << " s\n";
+            if (!*quiet) {
+                std::ostringstream line;
+                line << "sweep: step " << r.step << "  gamma = " << r.t << "  s = " << r.stress_path
+                     << "  ds/dgamma = " << r.K << "  iterations = " << r.iterations << "  retries = " << r.retries
+                     << "  " << r.seconds << " s" << eta(r.t);
+                progress_line(line.str());
+            }
         };
         // Ctrl-C and SIGTERM end the sweep after the step in progress, unless the caller ignores them (a background
         // job of a script inherits SIGINT ignored): that disposition is kept.
@@ -295,7 +344,7 @@ void register_sweep(CLI::App& app) {
         if (o.completed && rows > 0) write_checkpoint(*ckpt, params, rows, last, true);
         // A sweep that failed before its first row (the reference state's linear response) leaves no files: a CSV
         // of its header alone would read as a sweep with no steps.
-        if (rows == 0) std::remove(out->c_str());
+        if (rows == 0) std::remove(out->c_str()), std::remove((*out + ".json").c_str());
         emit_json({{"status", o.completed ? "completed" : o.interrupted ? "interrupted" : "failed"},
                    {"message", o.message},
                    {"rows", rows},

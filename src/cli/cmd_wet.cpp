@@ -233,43 +233,23 @@ nlohmann::json free_box_json(const FreeBoxResult& f, const FreeBoxOptions& o) {
 void register_wet(CLI::App& app) {
     auto* cmd = app.add_subcommand("wet", "wet a network: capillary bridges, bundles, pores, moduli dry and wet");
     auto flags = std::make_shared<SceneFlags>();
-    flags->add(cmd, true);
+    flags->add(cmd, true, true);  // with [wet]'s flags: --beta, --law, --crossings, --fraction, --wet-seed, ...
     cmd->get_option("--pl")->description("crosslink probability in [0, 1] (default 0.5 here, as the thesis's wet networks)");
     struct WetFlags {
-        double beta = 0, fraction = 0;
         std::vector<std::string> betas;
-        std::string law, crossings, out;
-        std::uint64_t seed = 0;
-        bool no_moduli = false, verbose = false, quiet = false, free_box = false;
-        std::string free_box_shape;
-        double free_box_tol = 0;
+        std::string out;
+        bool no_moduli = false, verbose = false, quiet = false;
         double modulus_strain = 0;
-        int bundle_partners = 0;
     };
     auto w = std::make_shared<WetFlags>();
-    auto* o_beta = cmd->add_option("--beta", w->beta, "adhesion per unit bundle length, bending units (default 1)");
     // Split by parse_betas, not by CLI11's delimiter, which drops empty entries.
     cmd->add_option("--betas", w->betas, "a beta sweep, comma-separated, e.g. --betas 0,0.1,0.3,1 (overrides --beta)");
-    auto* o_law = cmd->add_option("--law", w->law, "tabulated capillary law file: lines 'alpha_deg value'");
-    auto* o_cr = cmd->add_option("--crossings", w->crossings, "wet crossings: all | free | fraction (default all)");
-    auto* o_fr = cmd->add_option("--fraction", w->fraction, "wet fraction of crossings, in [0, 1]");
-    auto* o_ws = cmd->add_option("--wet-seed", w->seed, "seed of the wet fraction draw (with --crossings fraction)")->check(seed_check());
-    auto* o_bp = cmd->add_option("--bundle-partners", w->bundle_partners,
-                                 "excluded volume: a segment adheres along at most N other fibers (0: no cap, the "
-                                 "default; 2: flat ribbon; 6: close-packed; docs/wet.md)");
     cmd->add_option("-o,--out-dir", w->out,
                     "write summary.json, sweep.csv, pores.csv, network.svg, pores.svg here (created if missing)");
     cmd->add_flag("--no-moduli", w->no_moduli, "skip the dry and wet shear moduli");
     auto* o_ms = cmd->add_option("--modulus-strain", w->modulus_strain,
                                  "shear strain h of the moduli's second difference of relaxed energies at +-h, "
                                  "reported beside the exact linear moduli (default 1e-4; docs/wet.md)");
-    auto* o_fb = cmd->add_flag("--free-box", w->free_box,
-                               "then find the zero-stress box of the wet network (drying shrinkage, docs/wet.md)");
-    auto* o_fbs = cmd->add_option("--free-box-shape", w->free_box_shape,
-                                  "isotropic (F = s F0, mean normal stress -> 0; default) | full (symmetric box "
-                                  "stretch, sigma_xx, sigma_yy, sigma_xy -> 0; less robust, docs/wet.md)");
-    auto* o_fbt = cmd->add_option("--free-box-tol", w->free_box_tol,
-                                  "free box converged at |sigma| <= tol * sigma_c (default 1e-3)");
     cmd->add_flag("-v,--verbose", w->verbose, "solver progress on stderr (one line per Newton iteration)");
     cmd->add_flag("-q,--quiet", w->quiet, "no progress lines on stderr (default: one per beta and per active-set round)");
     cmd->callback([=] {
@@ -277,17 +257,9 @@ void register_wet(CLI::App& app) {
         Scene s = flags->resolve(false);  // checked whole below, with the [wet] flags in
         refuse_trimmed_ends(s, "wet", "capillary bridges sit on the end arms");
         if (flags->scene_file.empty() && !flags->given("--pl")) s.mikado.pl = 0.5;  // the thesis's wet networks
-        if (o_beta->count()) s.wet.beta = w->beta;
-        if (o_law->count()) s.wet.law = w->law;
-        if (o_cr->count()) s.wet.crossings = w->crossings;
-        if (o_fr->count()) s.wet.fraction = w->fraction;
-        if (o_ws->count()) s.wet.seed = w->seed;
-        if (o_fb->count()) s.wet.free_box = w->free_box;
-        if (o_fbs->count()) s.wet.free_box_shape = w->free_box_shape;
-        if (o_fbt->count()) s.wet.free_box_tol = w->free_box_tol;
-        if (o_bp->count()) s.wet.bundle_partners = w->bundle_partners;
         s.source = flags->scene_file.empty() ? "command line" : flags->scene_file + " + command line";
         s.check();
+        record_scene(s);
         const std::vector<double> betas = w->betas.empty() ? std::vector<double>{s.wet.beta} : parse_betas(w->betas);
         for (double b : betas) s.check_beta(b, "command line", "--betas entry");
 
@@ -321,8 +293,8 @@ void register_wet(CLI::App& app) {
             opt.modulus_strain = w->modulus_strain;
         }
         make_solver(opt.solver, opt.solver_options);  // an unknown solver is an InputError before any work
-        if (!s.wet.free_box && (o_fbs->count() || o_fbt->count()))
-            throw InputError(std::string(o_fbs->count() ? "--free-box-shape" : "--free-box-tol") +
+        if (!s.wet.free_box && (flags->given("--free-box-shape") || flags->given("--free-box-tol")))
+            throw InputError(std::string(flags->given("--free-box-shape") ? "--free-box-shape" : "--free-box-tol") +
                              " given without --free-box (or [wet] free_box = true)");
         opt.free_box.enabled = s.wet.free_box;
         opt.free_box.isotropic = s.wet.free_box_shape == "isotropic";
@@ -417,6 +389,7 @@ void register_wet(CLI::App& app) {
             }
             nlohmann::json r = summary(false);
             r["interrupted"] = true;
+            r["provenance"] = provenance();
             g_report = json_text(r, 2) + "\n";
             std::ostringstream m;
             m << "wet: interrupted during beta = " << betas[k] << " (" << k + 1 << " of " << betas.size() << "); "
@@ -438,15 +411,27 @@ void register_wet(CLI::App& app) {
         if (!json_capture()) interrupts.emplace();
         checkpoint(0);
         release();
+        const auto t_betas = std::chrono::steady_clock::now();
         for (size_t k = 0; k < betas.size(); ++k) {
             opt.params.beta = betas[k];
-            if (!w->quiet) std::fprintf(stderr, "wet: beta = %g (%zu of %zu)\n", betas[k], k + 1, betas.size());
+            if (!w->quiet) {
+                // ETA: the betas left at the mean time of those done (larger betas usually take longer: a floor).
+                char line[160];
+                if (k == 0) std::snprintf(line, sizeof line, "wet: beta = %g (1 of %zu)", betas[k], betas.size());
+                else
+                    std::snprintf(line, sizeof line, "wet: beta = %g (%zu of %zu), ETA %.0f s", betas[k], k + 1,
+                                  betas.size(), seconds_since(t_betas) / k * (betas.size() - k));
+                progress_line(line);
+            }
             const WetRun r = run_wet(net, m, F, opt, k == 0 ? nullptr : &dry_state);
             hold();  // beta k is finished: from here until its files are written, an interrupt waits
-            if (!w->quiet)
-                std::fprintf(stderr, "wet: beta = %g: %s, %zu bridges, %d solver iterations, %.1f s\n", betas[k],
-                             r.active.message.c_str(), r.active.bridges.size(), r.active.solver_iterations,
-                             r.active.seconds_solve + r.active.seconds_events);
+            if (!w->quiet) {
+                char line[400];
+                std::snprintf(line, sizeof line, "wet: beta = %g: %s, %zu bridges, %d solver iterations, %.1f s",
+                              betas[k], r.active.message.c_str(), r.active.bridges.size(), r.active.solver_iterations,
+                              r.active.seconds_solve + r.active.seconds_events);
+                progress_line(line);
+            }
             if (k == 0) dry_state = r.dry;
             const bool wet_good = r.dry.converged && r.wet.converged && r.active.stable;
             const bool box_good = !opt.free_box.enabled || r.free_box.converged;

@@ -17,7 +17,10 @@
 #include <sstream>
 
 #include "fibernet/network/network_io.hpp"
+#include "fibernet/scene/scene_options.hpp"
+#include "fibernet/scene/scene_toml.hpp"
 #include "fibernet/util/error.hpp"
+#include "fibernet_version.hpp"
 
 namespace fibernet::cli {
 
@@ -91,27 +94,28 @@ CLI::Validator seed_check() {
         "SEED");
 }
 
-void SceneFlags::add(CLI::App* app, bool with_load) {
+void SceneFlags::add(CLI::App* app, bool with_load, bool with_wet) {
     opts.push_back(app->add_option("scene", scene_file, "scene file (TOML, see docs/formats.md); flags override it")
                        ->check(CLI::ExistingFile));
-    opts.push_back(app->add_option("--network", network_file, "read this network file instead of generating one")
-                       ->check(CLI::ExistingFile));
-    opts.push_back(app->add_option("--L", L, "box side in fiber lengths (default 10)"));
-    opts.push_back(app->add_option("--q", q, "density N lf^2 / A (default 8)"));
-    opts.push_back(app->add_option("--pl", pl, "crosslink probability in [0, 1] (default 1)"));
-    opts.push_back(app->add_option("--seed", seed, "random seed, an integer in [0, 2^64) (default 1)")->check(seed_check()));
-    opts.push_back(app->add_flag("--open", open, "open box instead of periodic"));
-    opts.push_back(app->add_option("--scheme", scheme, "discretization: seed | even (default seed)"));
-    opts.push_back(app->add_option("--nseg", n_seg, "seed scheme: segments per fiber (default 10)"));
-    opts.push_back(app->add_option("--h", h, "even scheme: segment length in seed units (default 1)"));
-    opts.push_back(app->add_option("--a", a, "fiber aspect ratio a = ls / r (default 10)"));
-    opts.push_back(app->add_option("--prune", prune, "drop load-free parts: dangling, nonspanning, ends (docs/moduli.md)"));
-    if (with_load) {
-        opts.push_back(app->add_option("--gamma", gamma, "strain parameter (default 0)"));
-        opts.push_back(app->add_option("--strain", strain, "strain path: shear | uniaxial | uniaxial-y | isotropic"));
-        opts.push_back(app->add_option("--solver", solver, "solver (default newton)"));
-        opts.push_back(app->add_option("--tol", tol, "max |gradient| to stop at (default 1e-10)"));
-        opts.push_back(app->add_option("--max-iter", max_iter, "iteration limit (default 500)"));
+    const Scene defaults;
+    for (const SceneOption& o : scene_options()) {
+        if (o.flag.empty()) continue;
+        if ((o.table == "load" || o.table == "solver") && !with_load) continue;
+        if (o.table == "wet" && !with_wet) continue;
+        std::string doc = o.doc;
+        if (o.kind != OptionKind::Boolean && !(o.kind == OptionKind::Text && o.text(const_cast<Scene&>(defaults)).empty()))
+            doc += " (default " + o.literal(defaults) + ")";
+        CLI::Option* cli = o.kind == OptionKind::Boolean ? app->add_flag(o.flag, switches[o.flag], doc)
+                                                         : app->add_option(o.flag, values[o.flag], doc);
+        if (o.kind == OptionKind::Real) cli->type_name("NUMBER");
+        if (o.kind == OptionKind::Integer) cli->type_name("INT");
+        if (o.kind == OptionKind::Choice) cli->type_name("WORD");
+        if (o.kind == OptionKind::Seed) cli->check(seed_check());
+        if (o.existing_file) cli->check(CLI::ExistingFile);
+        opts.push_back(cli);
+        if (o.key == "a")  // --prune after the model's flags, as in a scene's [model]
+            opts.push_back(app->add_option("--prune", prune,
+                                           "drop load-free parts: dangling, nonspanning, ends (docs/moduli.md)"));
     }
 }
 
@@ -125,19 +129,12 @@ Scene SceneFlags::resolve(bool complete) const {
     Scene s = scene_file.empty() ? Scene{} : load_scene(scene_file);
     const std::string who = "command line";
     bool flags = false;
-    auto set = [&](const char* name, auto& target, const auto& value) {
-        if (given(name)) target = value, flags = true;
-    };
-    set("--network", s.network_file, network_file);
-    set("--L", s.mikado.L, L);
-    set("--q", s.mikado.q, q);
-    set("--pl", s.mikado.pl, pl);
-    set("--seed", s.mikado.seed, seed);
-    if (given("--open")) s.mikado.periodic = false, flags = true;
-    if (given("--scheme")) s.discretization.scheme = parse_scheme(scheme), flags = true;
-    set("--nseg", s.discretization.n_seg, n_seg);
-    set("--h", s.discretization.h, h);
-    set("--a", s.discretization.aspect_ratio, a);
+    for (const SceneOption& o : scene_options()) {
+        if (o.flag.empty() || !given(o.flag)) continue;
+        flags = true;
+        if (o.kind == OptionKind::Boolean) o.boolean(s) = o.flag_sets_false ? !switches.at(o.flag) : switches.at(o.flag);
+        else o.set_from_text(s, values.at(o.flag), who);
+    }
     if (given("--prune")) {
         flags = true;
         for (const auto& p : prune) {
@@ -147,11 +144,6 @@ Scene SceneFlags::resolve(bool complete) const {
             else throw InputError("command line: --prune " + p + " is unknown (expected dangling, nonspanning or ends)");
         }
     }
-    set("--gamma", s.gamma, gamma);
-    if (given("--strain")) s.strain = parse_strain_kind(strain), flags = true;
-    set("--solver", s.solver.name, solver);
-    set("--tol", s.solver.tol, tol);
-    set("--max-iter", s.solver.max_iter, max_iter);
     if (flags) s.source = scene_file.empty() ? who : scene_file + " with command-line overrides";
     // A saved network brings its own box and fibers: generation flags would be silently ignored.
     if (!s.network_file.empty())
@@ -159,7 +151,7 @@ Scene SceneFlags::resolve(bool complete) const {
             if (given(g))
                 throw InputError(std::string("command line: ") + g + " has no effect on a saved network ('" +
                                  s.network_file + "' gives the box and the fibers); remove " + g);
-    if (complete) s.check();
+    if (complete) s.check(), record_scene(s);
     else s.check_values();
     return s;
 }
@@ -206,12 +198,74 @@ nlohmann::json*& json_capture() {
     return capture;
 }
 
+bool& capture_provenance() {
+    static bool with = false;
+    return with;
+}
+
+namespace {
+std::optional<std::string>& recorded_scene() {
+    static std::optional<std::string> toml;
+    return toml;
+}
+
+// A word of a command line as a POSIX shell reads it back.
+std::string shell_quoted(const std::string& w) {
+    if (!w.empty() && w.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=/.,:@%") ==
+                          std::string::npos)
+        return w;
+    std::string q = "'";
+    for (char c : w) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+}  // namespace
+
+void forget_scene() { recorded_scene().reset(); }
+
+void record_scene(const Scene& s) {
+    // A scan's sample: the scan records its own scenes.
+    if (!json_capture() || capture_provenance()) recorded_scene() = to_toml(s);
+}
+
+nlohmann::json units_json() {
+    return {{"length", "seed unit ls = lf / 10 (a fiber has length fiber_length = 10; network files use lf)"},
+            {"energy", "bending energy of a unit length bent to unit curvature (kappa / ls)"},
+            {"stress", "energy / length^2 (2D: force per unit length)"},
+            {"modulus", "energy / length^2 (2D), as stress"},
+            {"angle", "rad"},
+            {"time", "s (wall clock)"}};
+}
+
+nlohmann::json provenance() {
+    std::string line = "fibernet";
+    for (const auto& w : command_argv()) line += " " + shell_quoted(w);
+    nlohmann::json p = {{"command", line},
+                        {"fibernet", {{"version", FIBERNET_VERSION}, {"commit", FIBERNET_GIT_COMMIT}}},
+                        {"units", units_json()}};
+    if (recorded_scene()) p["scene_toml"] = *recorded_scene();
+    return p;
+}
+
+void write_csv_sidecar(const std::string& csv, const nlohmann::json& parameters, const nlohmann::json& columns) {
+    const nlohmann::json side = {{"table", csv},
+                                 {"format", "CSV with a header row; numbers with 17 significant digits"},
+                                 {"columns", columns},
+                                 {"parameters", parameters},
+                                 {"provenance", provenance()}};
+    write_file_atomic(csv + ".json", json_text(side, 2) + "\n");
+}
+
 void emit_json(const nlohmann::json& j, const std::string& path) {
-    if (path.empty() && json_capture()) {
-        *json_capture() = j;
+    nlohmann::json out = j;
+    const bool captured = path.empty() && json_capture();
+    // A scan's sample leaves the provenance to the scan's manifest.
+    if (out.is_object() && !out.contains("provenance") && (!captured || capture_provenance()))
+        out["provenance"] = provenance();
+    if (captured) {
+        *json_capture() = std::move(out);
         return;
     }
-    const std::string text = json_text(j, 2) + "\n";
+    const std::string text = json_text(out, 2) + "\n";
     if (path.empty()) std::cout << text, flush_stdout();
     else write_file_atomic(path, text);
 }
@@ -237,6 +291,16 @@ SignalScope::SignalScope(void (*handler)(int)) {
 SignalScope::~SignalScope() {
     sigaction(SIGINT, &old_int_, nullptr);
     sigaction(SIGTERM, &old_term_, nullptr);
+}
+
+std::function<void(const std::string&)>& progress_sink() {
+    static std::function<void(const std::string&)> sink;
+    return sink;
+}
+
+void progress_line(const std::string& line) {
+    if (progress_sink()) progress_sink()(line);
+    else std::cerr << line << "\n";
 }
 
 std::vector<std::string>& command_argv() {

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <csignal>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -18,22 +19,20 @@
 
 namespace fibernet::cli {
 
-// Flags that set or override a scene: a positional scene file, network generation, discretization, load.
+// Flags that set or override a scene: a positional scene file and the flags of the scene options
+// (fibernet/scene/scene_options.hpp, where each is declared once), plus --prune.
 struct SceneFlags {
-    std::string scene_file, network_file;
-    double L = 0, q = 0, pl = 0, h = 0, a = 0, gamma = 0, tol = 0;
-    std::uint64_t seed = 0;
-    int n_seg = 0, max_iter = 0;
-    bool open = false;
-    std::string scheme, strain, solver;
+    std::string scene_file;
+    std::map<std::string, std::string> values;  // a flag's text, by flag ("--L")
+    std::map<std::string, bool> switches;       // a Boolean option's flag (--open, --free-box)
     std::vector<std::string> prune;
     std::vector<CLI::Option*> opts;
 
-    // with_load: also --gamma/--strain/--solver/--tol/--max-iter.
-    void add(CLI::App* app, bool with_load);
+    // with_load: also [load] and [solver] (--gamma, --strain, --solver, --tol, --max-iter); with_wet: [wet]'s flags.
+    void add(CLI::App* app, bool with_load, bool with_wet = false);
     bool given(const std::string& name) const;
     // The scene file (or defaults) overridden by the flags given, checked (Scene::check); complete = false leaves the
-    // combined check to a command that overrides more (fibernet wet's [wet] flags), which then calls Scene::check.
+    // combined check to a command that changes more (fibernet wet's thesis default pl), which then calls Scene::check.
     Scene resolve(bool complete = true) const;
 };
 
@@ -77,8 +76,19 @@ bool parse_decimal(const std::string& text, double& v);
 std::string json_text(const nlohmann::json& j, int indent = -1);
 // Prints JSON to stdout (or to `path` atomically when non-empty). While json_capture() points at a JSON value,
 // what would go to stdout is stored there instead (fibernet scan runs a command per sample in its own process).
+// A JSON object gets a "provenance" member: the command line as a shell reruns it, fibernet's version and commit, the
+// units, and the whole scene the command resolved (scene_toml: `fibernet <command> that.toml` computes it again).
 void emit_json(const nlohmann::json& j, const std::string& path = "");
+// The scene a command computes, for the provenance of what it emits (SceneFlags::resolve records it; a command that
+// changes the scene after resolving records it again).
+void record_scene(const Scene& s);
+void forget_scene();  // before a command runs in process after another
+nlohmann::json provenance();
+// CSV.json beside a CSV: what each column means and its unit, the parameters that determine the rows, provenance.
+void write_csv_sidecar(const std::string& csv, const nlohmann::json& parameters, const nlohmann::json& columns);
+nlohmann::json units_json();
 nlohmann::json*& json_capture();
+bool& capture_provenance();  // whether captured JSON gets its provenance too (the Python package: yes; scan: no)
 // Flushes standard output; OutputError (exit 4) when it cannot be written.
 void flush_stdout();
 // The bytes of a file a result depends on (a network file, a law table), e.g. for its fingerprint (util/hash.hpp);
@@ -86,6 +96,11 @@ void flush_stdout();
 std::string file_bytes(const std::string& path, const std::string& what);
 
 double seconds_since(const std::chrono::steady_clock::time_point& t0);
+
+// A progress line of a long command (sweep steps, wet betas): to stderr, or to the sink when one is set (the Python
+// package's progress callback).
+void progress_line(const std::string& line);
+std::function<void(const std::string&)>& progress_sink();
 
 // The command line as given (without the program name), set by main: recorded in results for provenance.
 std::vector<std::string>& command_argv();

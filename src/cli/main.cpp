@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "common.hpp"
+#include "in_process.hpp"
 #include "fibernet_version.hpp"
 #include "fibernet/util/error.hpp"
 #include "fibernet/util/parallel.hpp"
@@ -14,17 +15,7 @@ int main(int argc, char** argv) {
     CLI::App app{"fibernet: mechanics of random fiber networks by implicit energy minimization", "fibernet"};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("fibernet ") + FIBERNET_VERSION + " (" + FIBERNET_GIT_COMMIT + ")");
-    cli::register_generate(app);
-    cli::register_export(app);
-    cli::register_info(app);
-    cli::register_rigidity(app);
-    cli::register_compare(app);
-    cli::register_percolation(app);
-    cli::register_modulus(app);
-    cli::register_relax(app);
-    cli::register_wet(app);
-    cli::register_sweep(app);
-    cli::register_scan(app);
+    cli::register_commands(app);
     for (int i = 1; i < argc; ++i) cli::command_argv().push_back(argv[i]);
     if (argc == 1) {  // nothing asked: the usage, as an input error (CLI11 alone says only "A subcommand is required")
         std::cerr << app.help() << "\nfibernet: error: give a command (fibernet <command> --help for its flags)\n";

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "common.hpp"
+#include "in_process.hpp"
 #include "fibernet/util/error.hpp"
 
 namespace fibernet::cli {
@@ -19,17 +20,15 @@ const std::map<std::string, Registrar>& registrars() {
     return r;
 }
 
-// Arguments a scan sets itself: the scene flags (taken from SceneFlags::add, their one declaration; their values come
-// from the scene file and the grid), wet's [wet] overrides, and the outputs.
+// Arguments a scan sets itself: the scene flags, wet's [wet] ones included (from SceneFlags::add, which declares them
+// from scene_options(); their values come from the scene file and the grid), and the outputs.
 const std::set<std::string>& reserved() {
     static const std::set<std::string> r = [] {
-        std::set<std::string> names = {"--beta", "--law", "--crossings", "--fraction", "--wet-seed", "--bundle-partners",
-                                       "--free-box", "--free-box-shape", "--free-box-tol", "-o", "--out", "--out-dir",
-                                       "--output", "--svg", "--table", "--summary", "--checkpoint", "--resume", "-v",
-                                       "--verbose", "-q", "--quiet"};
+        std::set<std::string> names = {"-o",    "--out",     "--out-dir",    "--output", "--svg", "--table", "--summary",
+                                       "--checkpoint", "--resume", "-v", "--verbose", "-q", "--quiet"};
         CLI::App app;
         SceneFlags flags;
-        flags.add(app.add_subcommand("any"), true);
+        flags.add(app.add_subcommand("any"), true, true);
         for (const CLI::Option* o : flags.opts) {
             for (const auto& l : o->get_lnames()) names.insert("--" + l);
             for (const auto& sn : o->get_snames()) names.insert("-" + sn);
@@ -92,26 +91,7 @@ void check_job_args(const std::string& job, const std::vector<std::string>& args
 JobOutcome run_job(const std::string& job, const std::string& scene_file, const std::vector<std::string>& args) {
     CLI::App app;
     CLI::App* cmd = make_command(app, job);
-    JobOutcome out;
-    json_capture() = &out.result;
-    exit_code() = 0;
-    struct Reset {
-        ~Reset() { json_capture() = nullptr; }
-    } reset;
-    try {
-        parse(app, argv_of(cmd, job, scene_file, args));
-        out.exit_code = exit_code();
-    } catch (const CLI::ParseError& e) {
-        throw InputError(std::string("the arguments of ") + job + ": " + e.what());
-    } catch (const InputError&) {
-        throw;
-    } catch (const OutputError&) {
-        throw;
-    } catch (const std::exception& e) {
-        out.exit_code = 3, out.error = e.what(), out.result = nullptr;
-    }
-    exit_code() = 0;
-    return out;
+    return run_command(app, argv_of(cmd, job, scene_file, args), false);
 }
 
 }  // namespace fibernet::cli

@@ -5,16 +5,14 @@
 #include <string>
 #include <vector>
 
+#include "in_process.hpp"
+
 namespace fibernet::cli {
 
 // The commands a scan can run per sample.
 const std::vector<std::string>& scan_jobs();
 
-struct JobOutcome {
-    int exit_code = 0;       // the command's: 0 success, 1 not converged / failed, 130 interrupted, 3 internal error
-    nlohmann::json result;   // the command's JSON (null if it threw)
-    std::string error;       // the message of an internal error
-};
+using JobOutcome = CommandOutcome;
 
 // Runs `job` with argv {scene_file, -q (where the command has it), args...}. An InputError (a refusal of the scene or
 // the arguments) and an OutputError propagate: they concern every sample, not this one.

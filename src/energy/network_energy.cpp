@@ -112,6 +112,16 @@ Eigen::VectorXd NetworkEnergy::dofs(const Eigen::VectorXd& x) const {
     return q;
 }
 
+Eigen::VectorXd NetworkEnergy::dofs_of_displacements(const Eigen::VectorXd& u) const {
+    if (u.size() != static_cast<Eigen::Index>(dof_.size()))
+        throw std::invalid_argument("NetworkEnergy::dofs_of_displacements: u has " + std::to_string(u.size()) +
+                                    " entries, the model " + std::to_string(dof_.size()) + " node coordinates");
+    Eigen::VectorXd q(ndof_);
+    for (size_t k = 0; k < dof_.size(); ++k)
+        if (dof_[k] >= 0) q[dof_[k]] = u[k];
+    return q;
+}
+
 namespace {
 // Eigen checks no sizes with NDEBUG: a q of another model would read past its end.
 void check_size(const Eigen::VectorXd& q, int ndof, const char* where) {

@@ -4,33 +4,43 @@
 #include <istream>
 #include <ostream>
 #include <sstream>
+#include <stdexcept>
 
 #include "fibernet/util/error.hpp"
 
 namespace fibernet {
 
-void write_model(std::ostream& os, const Model& m, const Eigen::VectorXd& xin, const Eigen::Matrix2d& F) {
-    const Eigen::VectorXd& x = xin.size() ? xin : m.x;
+void write_model(std::ostream& os, const Model& m, const Eigen::VectorXd& uin, const Eigen::Matrix2d& F) {
+    const Eigen::VectorXd u = uin.size() ? uin : Eigen::VectorXd::Zero(m.x.size());
+    if (u.size() != m.x.size())
+        throw std::invalid_argument("write_model: " + std::to_string(u.size()) + " displacements for " +
+                                    std::to_string(m.x.size()) + " node coordinates");
     os.precision(17);
-    os << "fibernet-model 1\n";
+    os << "fibernet-model 2\n";
     os << "box " << m.box.L << ' ' << (m.box.periodic ? "periodic" : "open") << '\n';
     os << "deformation " << F(0, 0) << ' ' << F(0, 1) << ' ' << F(1, 0) << ' ' << F(1, 1) << '\n';
     os << "aspect_ratio " << m.aspect_ratio << '\n';
     os << "fiber_length " << m.fiber_length << '\n';
     os << "softcore_eps_star -0.95\n";
     os << "nodes " << m.num_nodes() << '\n';
+    // The position is for other programs; the state is x_ref + u, read back from u exactly (x itself has lost the
+    // low bits of u that the gradient at an equilibrium depends on).
     for (int i = 0; i < m.num_nodes(); ++i)
-        os << x[2 * i] << ' ' << x[2 * i + 1] << ' ' << (m.fixed.empty() ? 0 : int(m.fixed[i])) << ' '
-           << m.x[2 * i] << ' ' << m.x[2 * i + 1] << '\n';
+        os << m.x[2 * i] + u[2 * i] << ' ' << m.x[2 * i + 1] + u[2 * i + 1] << ' '
+           << (m.fixed.empty() ? 0 : int(m.fixed[i])) << ' ' << m.x[2 * i] << ' ' << m.x[2 * i + 1] << ' ' << u[2 * i]
+           << ' ' << u[2 * i + 1] << '\n';
     const double k = 4 * m.aspect_ratio * m.aspect_ratio;
     os << "segments " << m.segments.size() << '\n';
+    // Rest vectors too: derived from the rounded reference positions they would move |g| by 4 a^2 ulp(L) / l0, which
+    // on a 1e-3 segment is 1e-9 (format 2; NaN, from positions, where the model has none).
     for (const auto& s : m.segments)
         os << s.i << ' ' << s.j << ' ' << s.shift.x() << ' ' << s.shift.y() << ' ' << s.l0 << ' ' << s.fiber << ' '
-           << k / s.l0 << '\n';
+           << k / s.l0 << ' ' << s.d0.x() << ' ' << s.d0.y() << '\n';
     os << "hinges " << m.hinges.size() << '\n';
     for (const auto& h : m.hinges)
         os << h.i << ' ' << h.j << ' ' << h.k << ' ' << h.shift1.x() << ' ' << h.shift1.y() << ' ' << h.shift2.x()
-           << ' ' << h.shift2.y() << ' ' << h.lt0 << ' ' << h.fiber << ' ' << 2 / h.lt0 << '\n';
+           << ' ' << h.shift2.y() << ' ' << h.lt0 << ' ' << h.fiber << ' ' << 2 / h.lt0 << ' ' << h.d10.x() << ' '
+           << h.d10.y() << ' ' << h.d20.x() << ' ' << h.d20.y() << '\n';
     os << "supernodes " << m.supernodes.size() << '\n';
     for (const auto& s : m.supernodes) {
         os << s.node << ' ' << s.crossings.size();
@@ -60,10 +70,19 @@ struct Reader {
     double num(std::istringstream& ss, const char* name) {
         std::string t;
         if (!(ss >> t)) fail(std::string("missing ") + name);
+        return parse(t, name);
+    }
+    double parse(const std::string& t, const char* name) {
         char* end;
         double v = std::strtod(t.c_str(), &end);
         if (*end || end == t.c_str() || !std::isfinite(v)) fail(std::string(name) + " = '" + t + "' is not a finite number");
         return v;
+    }
+    // A rest vector component: a finite number, or nan (derive it from the reference positions).
+    double num_or_nan(std::istringstream& ss, const char* name) {
+        std::string t;
+        if (!(ss >> t)) fail(std::string("missing ") + name);
+        return t == "nan" || t == "-nan" ? NAN : parse(t, name);
     }
     long integer(std::istringstream& ss, const char* name, long lo, long hi) {
         std::string t;
@@ -91,15 +110,16 @@ struct Reader {
 };
 }  // namespace
 
-Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* xout, Eigen::Matrix2d* Fout) {
+Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* uout, Eigen::Matrix2d* Fout) {
     Reader r{is, source};
     Model m;
+    int version = 0;
     {
         auto ss = r.next("header");
         std::string h;
         ss >> h;
         if (h != "fibernet-model") r.fail("not a fibernet model file (header '" + r.text + "')");
-        r.integer(ss, "format version", 1, 1);
+        version = static_cast<int>(r.integer(ss, "format version", 1, 2));
     }
     {
         auto ss = r.next("box");
@@ -123,14 +143,19 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* x
     m.fiber_length = r.keyed("fiber_length");
     r.keyed("softcore_eps_star");
     const long n = r.section("nodes");
-    Eigen::VectorXd x(2 * n);
+    Eigen::VectorXd u(2 * n);
     m.x.resize(2 * n);
     m.fixed.assign(n, 0);
     for (long i = 0; i < n; ++i) {
         auto ss = r.next("node");
-        x[2 * i] = r.num(ss, "node x"), x[2 * i + 1] = r.num(ss, "node y");
+        const double x = r.num(ss, "node x"), y = r.num(ss, "node y");
         m.fixed[i] = static_cast<char>(r.integer(ss, "node fixed flag", 0, 1));
         m.x[2 * i] = r.num(ss, "node x_ref"), m.x[2 * i + 1] = r.num(ss, "node y_ref");
+        if (version == 1) {  // positions only: u as well as x can hold it
+            u[2 * i] = x - m.x[2 * i], u[2 * i + 1] = y - m.x[2 * i + 1];
+        } else {
+            u[2 * i] = r.num(ss, "node ux"), u[2 * i + 1] = r.num(ss, "node uy");
+        }
     }
     const long ns = r.section("segments");
     m.segments.resize(ns);
@@ -142,6 +167,10 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* x
         s.l0 = r.num(ss, "segment l0");
         if (s.l0 <= 0) r.fail("segment l0 = " + show(s.l0) + " must be > 0");
         s.fiber = r.integer(ss, "segment fiber", 0, 2000000000);
+        if (version >= 2) {
+            r.num(ss, "segment K");
+            s.d0.x() = r.num_or_nan(ss, "segment d0x"), s.d0.y() = r.num_or_nan(ss, "segment d0y");
+        }
     }
     const long nh = r.section("hinges");
     m.hinges.resize(nh);
@@ -156,6 +185,11 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* x
         h.lt0 = r.num(ss, "hinge lt0");
         if (h.lt0 <= 0) r.fail("hinge lt0 = " + show(h.lt0) + " must be > 0");
         h.fiber = r.integer(ss, "hinge fiber", 0, 2000000000);
+        if (version >= 2) {
+            r.num(ss, "hinge Kb");
+            h.d10.x() = r.num_or_nan(ss, "hinge d10x"), h.d10.y() = r.num_or_nan(ss, "hinge d10y");
+            h.d20.x() = r.num_or_nan(ss, "hinge d20x"), h.d20.y() = r.num_or_nan(ss, "hinge d20y");
+        }
     }
     const long nsn = r.section("supernodes");
     m.supernodes.resize(nsn);
@@ -165,7 +199,7 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* x
         const long k = r.integer(ss, "supernode crossing count", 0, 1000);
         for (long c = 0; c < k; ++c) s.crossings.push_back(r.integer(ss, "supernode crossing", 0, 2000000000));
     }
-    if (xout) *xout = x;
+    if (uout) *uout = u;
     if (Fout) *Fout = F;
     return m;
 }

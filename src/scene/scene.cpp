@@ -10,6 +10,7 @@
 
 #include "fibernet/energy/capillary.hpp"
 #include "fibernet/network/network_io.hpp"
+#include "fibernet/scene/scene_options.hpp"
 #include "fibernet/util/error.hpp"
 
 namespace fibernet {
@@ -127,6 +128,58 @@ struct TableReader {
                 throw InputError(where + ": unknown key '" + std::string(k.str()) + "'");
     }
 };
+// One declared option (scene_options.hpp) from its table, if given.
+void read_option(TableReader& r, const SceneOption& o, Scene& s) {
+    switch (o.kind) {
+        case OptionKind::Real: {
+            double v = 0;
+            if (r.get(o.key, v)) o.real(s) = v;
+            return;
+        }
+        case OptionKind::Integer: {
+            int v = 0;
+            if (r.get(o.key, v)) o.integer(s) = v;
+            return;
+        }
+        case OptionKind::Seed: r.get_seed(o.key, o.seed(s)); return;
+        case OptionKind::Boolean: {
+            bool v = false;
+            if (r.get(o.key, v)) o.boolean(s) = v;
+            return;
+        }
+        case OptionKind::Text: {
+            std::string v;
+            if (r.get(o.key, v)) o.text(s) = v;
+            return;
+        }
+        case OptionKind::Choice: {
+            std::string v;
+            if (!r.get(o.key, v)) return;
+            try {
+                o.set_choice(s, v);
+            } catch (const InputError& e) {
+                throw InputError(r.where + "." + o.key + ": " + e.what());
+            }
+            return;
+        }
+    }
+}
+
+// [model].prune, the one array of a scene.
+void read_prune(TableReader& r, Scene& s, const std::string& source) {
+    r.known.insert("prune");
+    if (auto* arr = r.t.get_as<toml::array>("prune")) {
+        for (const auto& el : *arr) {
+            auto v = el.value_exact<std::string>();
+            if (v && *v == "dangling") s.prune.dangling = true;
+            else if (v && *v == "nonspanning") s.prune.nonspanning = true;
+            else if (v && *v == "ends") s.discretization.trim_ends = true;
+            else throw InputError(source + ": [model].prune has an unknown entry (expected \"dangling\", \"nonspanning\", \"ends\")");
+        }
+    } else if (r.t.get("prune")) {
+        throw InputError(source + ": [model].prune must be an array of strings");
+    }
+}
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& source) {
@@ -151,86 +204,19 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         auto* t = root.get_as<toml::table>(name);
         return t ? *t : empty;
     };
-    {
-        TableReader r{table("network"), source + ": [network]"};
-        std::vector<std::string> generation;  // generation keys given (they have no effect with a file)
-        for (const char* k : {"L", "q", "pl", "seed", "periodic"})
-            if (r.t.get(k)) generation.push_back(k);
-        r.get("L", s.mikado.L);
-        r.get("q", s.mikado.q);
-        r.get("pl", s.mikado.pl);
-        r.get_seed("seed", s.mikado.seed);
-        r.get("periodic", s.mikado.periodic);
-        if (r.get("file", s.network_file) && !generation.empty())
-            throw InputError(source + ": [network].file = '" + s.network_file + "' is given with [network]." +
-                             generation.front() + ": a saved network brings its own box and fibers (remove one)");
-        r.finish();
-    }
-    {
-        TableReader r{table("model"), source + ": [model]"};
-        std::string scheme = to_string(s.discretization.scheme);
-        if (r.get("scheme", scheme)) {
-            try {
-                s.discretization.scheme = parse_scheme(scheme);
-            } catch (const InputError& e) {
-                throw InputError(source + ": [model].scheme: " + e.what());
-            }
+    for (const char* name : {"network", "model", "load", "solver", "wet"}) {
+        TableReader r{table(name), source + ": [" + name + "]"};
+        for (const SceneOption& o : scene_options())
+            if (o.table == name) read_option(r, o, s);
+        if (std::string(name) == "network") {
+            std::vector<std::string> generation;  // generation keys given (they have no effect with a file)
+            for (const char* k : {"L", "q", "pl", "seed", "periodic"})
+                if (r.t.get(k)) generation.push_back(k);
+            if (!s.network_file.empty() && !generation.empty())
+                throw InputError(source + ": [network].file = '" + s.network_file + "' is given with [network]." +
+                                 generation.front() + ": a saved network brings its own box and fibers (remove one)");
         }
-        r.get("n_seg", s.discretization.n_seg);
-        r.get("h", s.discretization.h);
-        r.get("a", s.discretization.aspect_ratio);
-        r.get("fiber_length", s.discretization.fiber_length);
-        r.known.insert("prune");
-        if (auto* arr = r.t.get_as<toml::array>("prune")) {
-            for (const auto& el : *arr) {
-                auto v = el.value_exact<std::string>();
-                if (v && *v == "dangling") s.prune.dangling = true;
-                else if (v && *v == "nonspanning") s.prune.nonspanning = true;
-                else if (v && *v == "ends") s.discretization.trim_ends = true;
-                else throw InputError(source + ": [model].prune has an unknown entry (expected \"dangling\", \"nonspanning\", \"ends\")");
-            }
-        } else if (r.t.get("prune")) {
-            throw InputError(source + ": [model].prune must be an array of strings");
-        }
-        r.finish();
-    }
-    {
-        TableReader r{table("load"), source + ": [load]"};
-        std::string strain = to_string(s.strain);
-        if (r.get("strain", strain)) {
-            try {
-                s.strain = parse_strain_kind(strain);
-            } catch (const InputError& e) {
-                throw InputError(source + ": [load].strain: " + e.what());
-            }
-        }
-        r.get("gamma", s.gamma);
-        r.finish();
-    }
-    {
-        TableReader r{table("solver"), source + ": [solver]"};
-        r.get("name", s.solver.name);
-        r.get("tol", s.solver.tol);
-        r.get("max_iter", s.solver.max_iter);
-        r.finish();
-    }
-    {
-        TableReader r{table("wet"), source + ": [wet]"};
-        r.get("beta", s.wet.beta);
-        r.get("law", s.wet.law);
-        r.get("crossings", s.wet.crossings);
-        r.get("fraction", s.wet.fraction);
-        r.get_seed("seed", s.wet.seed);
-        r.get("free_box", s.wet.free_box);
-        r.get("free_box_shape", s.wet.free_box_shape);
-        r.get("free_box_tol", s.wet.free_box_tol);
-        r.get("max_rounds", s.wet.max_rounds);
-        r.get("round_iterations", s.wet.round_iterations);
-        r.get("newton_ldl", s.wet.newton_ldl);
-        r.get("local_fraction", s.wet.local_fraction);
-        r.get("local_threshold", s.wet.local_threshold);
-        r.get("local_hops", s.wet.local_hops);
-        r.get("bundle_partners", s.wet.bundle_partners);
+        if (std::string(name) == "model") read_prune(r, s, source);
         r.finish();
     }
     s.check_values();  // the combinations once overrides are in (Scene::check)
@@ -247,7 +233,8 @@ Scene load_scene(const std::string& path) {
     const std::string body = text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text;  // a UTF-8 BOM
     for (const auto& [magic, what] : std::vector<std::array<std::string, 2>>{
              {"fibernet-network", "a network file, not a scene (TOML): give it as --network " + path},
-             {"fibernet-model", "a model file (what export and relax write), not a scene (TOML)"},
+             {"fibernet-model", "a model file (what export and relax write), not a scene (TOML): fibernet export --model " + path +
+                                   " exports its state"},
              {"fibernet-sweep-checkpoint", "a sweep checkpoint, not a scene (TOML): continue its sweep with sweep --resume"}})
         if (body.rfind(magic, 0) == 0) throw InputError("'" + path + "' is " + what);
     Scene s = parse_scene(text, path);

@@ -14,12 +14,45 @@ std::string color_of(int label) {
 }
 }  // namespace
 
+namespace {
+// A bar one fiber length long (at the panels' scale) and what the marks mean, on one line at height y.
+std::string scale_and_legend(const Model& m, double px, double gap, double y) {
+    std::ostringstream os;
+    os.precision(5);
+    const double bar = px / m.box.L * m.fiber_length;
+    os << "<line x1=\"" << gap << "\" y1=\"" << y << "\" x2=\"" << gap + bar << "\" y2=\"" << y
+       << "\" stroke=\"black\" stroke-width=\"3\"/>\n<text x=\"" << gap + bar + 6 << "\" y=\"" << y + 4
+       << "\">1 fiber length (" << m.fiber_length << " seed units)</text>\n";
+    double x = gap + bar + 200;
+    auto item = [&](const std::string& mark, const std::string& label) {
+        os << mark << "<text x=\"" << x + 14 << "\" y=\"" << y + 4 << "\">" << label << "</text>\n";
+        x += 26 + 7 * label.size();
+    };
+    auto dot = [&](const char* fill, double r) {
+        std::ostringstream d;
+        d << "<circle cx=\"" << x + 5 << "\" cy=\"" << y << "\" r=\"" << r << "\" fill=\"" << fill << "\"/>";
+        return d.str();
+    };
+    auto dash = [&](const std::string& col, double w) {
+        std::ostringstream d;
+        d << "<line x1=\"" << x << "\" y1=\"" << y << "\" x2=\"" << x + 10 << "\" y2=\"" << y << "\" stroke=\"" << col
+          << "\" stroke-width=\"" << w << "\"/>";
+        return d.str();
+    };
+    item(dot("#ff4d4d", 2.2), "capillary bridge");
+    item(dot("#d62728", 1.3), "locked (zipped) bridge");
+    item(dash(color_of(0), 1.6) , "bundle (one colour each)");
+    item(dash("#555", 0.8), "fiber");
+    return os.str();
+}
+}  // namespace
+
 std::string network_svg(const Model& m, const std::vector<SvgPanel>& panels, double px) {
     std::ostringstream os;
     os.precision(5);
-    const double gap = 20, head = 24;
+    const double gap = 20, head = 24, foot = 30;  // the foot holds the scale bar and the legend
     os << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << panels.size() * (px + gap) + gap << "\" height=\""
-       << px + head + gap << "\" font-family=\"sans-serif\" font-size=\"13\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+       << px + head + gap + foot << "\" font-family=\"sans-serif\" font-size=\"13\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
     for (size_t p = 0; p < panels.size(); ++p) {
         const SvgPanel& P = panels[p];
         const double ox = gap + p * (px + gap), oy = head;
@@ -69,6 +102,7 @@ std::string network_svg(const Model& m, const std::vector<SvgPanel>& panels, dou
         }
         os << "</g>\n";
     }
+    os << scale_and_legend(m, px, gap, head + px + gap + 6);
     os << "</svg>\n";
     return os.str();
 }
@@ -112,6 +146,12 @@ std::string histogram_svg(const std::vector<std::string>& names, const std::vect
            << "\" stroke=\"black\"/><text x=\"" << xd - 12 << "\" y=\"" << y0 + h + 18 << "\">1e" << d << "</text>\n";
     }
     os << "<text x=\"" << x0 + w / 2 - 80 << "\" y=\"" << H - 8 << "\">" << xlabel << " (log bins)</text>\n";
+    for (double f : {0.0, 0.5, 1.0}) {  // the y axis: fractions of the tallest bar
+        const double yf = y0 + h - h * f;
+        os << "<line x1=\"" << x0 - 5 << "\" y1=\"" << yf << "\" x2=\"" << x0 << "\" y2=\"" << yf
+           << "\" stroke=\"black\"/><text x=\"" << x0 - 8 << "\" y=\"" << yf + 4 << "\" text-anchor=\"end\">"
+           << f * fmax << "</text>\n";
+    }
     os << "<text x=\"12\" y=\"" << y0 + h / 2 << "\" transform=\"rotate(-90 12 " << y0 + h / 2
        << ")\">fraction of pores</text>\n</svg>\n";
     return os.str();

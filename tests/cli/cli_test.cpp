@@ -19,7 +19,7 @@ TEST_CASE("cli: generate and export write documented files", "[cli]") {
     REQUIRE(run("generate --L 4 --q 5 --pl 1 --seed 1 -o " + net) == 0);
     CHECK(slurp(net).rfind("fibernet-network 1\n", 0) == 0);
     REQUIRE(run("export --network " + net + " --scheme even -o " + model) == 0);
-    CHECK(slurp(model).rfind("fibernet-model 1\n", 0) == 0);
+    CHECK(slurp(model).rfind("fibernet-model 2\n", 0) == 0);
     REQUIRE(run("info --network " + net) == 0);
     CHECK(slurp(tmpdir() + "/stdout").find("\"supernodes\"") != std::string::npos);
 }

@@ -167,7 +167,7 @@ TEST_CASE("cli relax: writes the equilibrium model and its stress", "[cli][relax
     const auto j = out();
     CHECK(j["status"] == "converged");
     CHECK(j["stress"]["xy"].get<double>() > 0);
-    CHECK(slurp(model).rfind("fibernet-model 1\n", 0) == 0);
+    CHECK(slurp(model).rfind("fibernet-model 2\n", 0) == 0);
     const std::string bad = dir() + "/not_written.txt";
     REQUIRE(run("relax --L 3 --q 8 --scheme even --gamma 0.05 --max-iter 1 -o " + bad) == 1);
     CHECK_FALSE(std::ifstream(bad).good());

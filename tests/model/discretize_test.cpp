@@ -119,15 +119,16 @@ TEST_CASE("model export round-trips exactly", "[model][io]") {
     d.scheme = Scheme::Even;
     const Model m = discretize(net_L4(), d);
     Eigen::Matrix2d F = deformation(StrainKind::Shear, 0.25);
-    Eigen::VectorXd x = m.x;
-    x[3] += 0.125;
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(m.x.size());
+    u[3] = 0.125;
+    u[4] = 1e-13;  // below the round-off of x_ref + u: only the displacement column keeps it
     std::stringstream ss;
-    write_model(ss, m, x, F);
-    Eigen::VectorXd x2;
+    write_model(ss, m, u, F);
+    Eigen::VectorXd u2;
     Eigen::Matrix2d F2;
-    const Model r = read_model(ss, "memory", &x2, &F2);
+    const Model r = read_model(ss, "memory", &u2, &F2);
     CHECK(F2 == F);
-    CHECK(x2 == x);
+    CHECK(u2 == u);
     CHECK(r.x == m.x);
     CHECK(r.box.L == m.box.L);
     CHECK(r.aspect_ratio == m.aspect_ratio);
@@ -146,11 +147,25 @@ TEST_CASE("model export round-trips exactly", "[model][io]") {
     }
     CHECK(r.supernodes.size() == m.supernodes.size());
     std::stringstream again;
-    write_model(again, r, x2, F2);
+    write_model(again, r, u2, F2);
     CHECK(again.str() == ss.str());
     std::istringstream bad("fibernet-model 1\nbox 3 periodic\ndeformation 1 0 0 1\naspect_ratio 10\nfiber_length 10\n"
                            "softcore_eps_star -0.95\nnodes 1\n0 0 0 0 0\nsegments 1\n0 3 0 0 1 0 400\n");
     CHECK_THROWS_WITH(read_model(bad, "m.txt"), Catch::Contains("m.txt:10: segment node j = 3 is out of range"));
+    std::istringstream v2_short("fibernet-model 2\nbox 3 periodic\ndeformation 1 0 0 1\naspect_ratio 10\n"
+                                "fiber_length 10\nsoftcore_eps_star -0.95\nnodes 1\n0 0 0 0 0\n");
+    CHECK_THROWS_WITH(read_model(v2_short, "m.txt"), Catch::Contains("m.txt:8: missing node ux"));
+}
+
+TEST_CASE("model format 1 (positions only) is still read", "[model][io]") {
+    std::istringstream v1("fibernet-model 1\nbox 3 periodic\ndeformation 1 0 0 1\naspect_ratio 10\nfiber_length 10\n"
+                          "softcore_eps_star -0.95\nnodes 2\n0.5 0 0 0.25 0\n1 1 0 1 1\nsegments 0\nhinges 0\n"
+                          "supernodes 0\n");
+    Eigen::VectorXd u;
+    read_model(v1, "v1.txt", &u);
+    REQUIRE(u.size() == 4);
+    CHECK(u[0] == 0.25);
+    CHECK(u.tail(3).isZero());
 }
 
 TEST_CASE("discretize trim_ends: chains run from the first to the last crosslink, interior unchanged", "[model][prune]") {

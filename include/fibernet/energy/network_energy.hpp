@@ -49,6 +49,8 @@ public:
     int num_dofs() const { return ndof_; }
     // Free coordinates (displacements) of a node-position vector (2 per node), and back (fixed nodes at F x_ref).
     Eigen::VectorXd dofs(const Eigen::VectorXd& x) const;
+    // The free coordinates of a displacement vector u (2 per node, u = x - x_ref): exact, where dofs(x_ref + u) rounds.
+    Eigen::VectorXd dofs_of_displacements(const Eigen::VectorXd& u) const;
     Eigen::VectorXd positions(const Eigen::VectorXd& q, const Eigen::Matrix2d& F) const;
     // Index of coordinate c of node i in q, or -1 if fixed.
     int dof(int node, int c) const { return dof_[2 * node + c]; }
