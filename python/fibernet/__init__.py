@@ -226,7 +226,8 @@ def sweep(scene=None, *, network=None, **options):
 
 
 def wet(scene=None, *, network=None, **options):
-    """A wet network (fibernet wet): the summary and result["sweep"], result["pores"], the CSV tables as arrays.
+    """A wet network (fibernet wet): the summary and result["sweep"], result["pores"], the CSV tables as arrays; each
+    result["runs"][k]["state"] is beta k's wet equilibrium as a State (None where it did not converge).
     out_dir keeps the files (SVGs, CSVs, summary.json); by default they go to a temporary directory."""
     with tempfile.TemporaryDirectory(prefix="fibernet-") as tmp:
         _network_option(tmp, network, options)
@@ -235,4 +236,6 @@ def wet(scene=None, *, network=None, **options):
         for name in ("sweep", "pores"):
             p = os.path.join(out, name + ".csv")
             result[name] = _read_csv(p) if os.path.exists(p) else {}
+        for run in result.get("runs", []):  # each beta's wet equilibrium, where it converged
+            run["state"] = load_state(os.path.join(out, run["state"])) if run.get("state") else None
         return result

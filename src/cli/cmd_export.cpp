@@ -68,7 +68,8 @@ void write_lammps_files(const ExportState& st, const std::string& base, bool qui
                   << " segments are in the softcore branch (eps < -0.95), which LAMMPS' harmonic bonds do not have\n";
     if (!quiet)
         std::cerr << "export: " << data_path << " and " << base << ".in (" << info.bond_types << " bond types, "
-                  << info.angle_types << " angle types); run: lmp -in " << base << ".in\n";
+                  << info.angle_types << " angle types); run it from their directory (the script reads " << data_name
+                  << "): lmp -in " << base.substr(base.find_last_of('/') + 1) << ".in\n";
 }
 
 void run_export(const SceneFlags& flags, const ExportArgs& a) {
@@ -82,15 +83,19 @@ void run_export(const SceneFlags& flags, const ExportArgs& a) {
     else check_outputs({{"--output", a.out}});
     const ExportState st = a.model_file.empty() ? from_scene(flags, a.format == "vtp") : from_model_file(a.model_file);
     std::ostringstream os;
-    if (a.format == "lammps") {
-        write_lammps_files(st, a.out, a.quiet);
-        return;
-    }
-    if (a.format == "vtp") {
-        const NetworkEnergy e(st.model);
-        write_vtp(os, e, e.dofs_of_displacements(st.u), st.F, st.fields);
-    } else {
-        write_model(os, st.model, st.u, st.F);
+    try {  // a state the format cannot hold: named with the file it came from
+        if (a.format == "lammps") {
+            write_lammps_files(st, a.out, a.quiet);
+            return;
+        }
+        if (a.format == "vtp") {
+            const NetworkEnergy e(st.model);
+            write_vtp(os, e, e.dofs_of_displacements(st.u), st.F, st.fields);
+        } else {
+            write_model(os, st.model, st.u, st.F);
+        }
+    } catch (const InputError& e) {
+        throw InputError((a.model_file.empty() ? st.source : "--model " + a.model_file) + ": " + e.what());
     }
     if (a.out.empty()) std::cout << os.str();
     else write_file_atomic(a.out, os.str());

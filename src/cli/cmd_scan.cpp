@@ -28,6 +28,7 @@
 #include "fibernet/util/parallel.hpp"
 
 extern "C" void openblas_set_num_threads(int);  // OpenBLAS (linked by CHOLMOD's BLAS, CMakeLists.txt)
+extern "C" int openblas_get_num_threads(void);
 
 namespace fibernet::cli {
 
@@ -386,10 +387,18 @@ void merge_from(const ScanDir& d, const std::vector<std::string>& sources) {
 
 // Element loops and OpenBLAS on one thread per rank unless asked otherwise: ranks are the parallelism (results do
 // not depend on thread counts, util/parallel.hpp).
-void one_thread_per_sample() {
-    if (!std::getenv("FIBERNET_THREADS")) set_thread_count(1);
-    if (!std::getenv("OPENBLAS_NUM_THREADS") && !std::getenv("OMP_NUM_THREADS")) openblas_set_num_threads(1);
-}
+// Put back when the scan ends: a process that runs more than the scan (the Python package) keeps its threads.
+struct OneThreadPerSample {
+    int blas = openblas_get_num_threads();
+    OneThreadPerSample() {
+        if (!std::getenv("FIBERNET_THREADS")) set_thread_count(1);
+        if (!std::getenv("OPENBLAS_NUM_THREADS") && !std::getenv("OMP_NUM_THREADS")) openblas_set_num_threads(1);
+    }
+    ~OneThreadPerSample() {
+        if (!std::getenv("FIBERNET_THREADS")) set_thread_count(0);
+        openblas_set_num_threads(blas);
+    }
+};
 
 // The base scene as the manifest keeps it: its files by absolute path, so the scan runs from any directory.
 Scene base_scene(const SceneFlags& flags) {
@@ -528,7 +537,7 @@ int run_scan(const SceneFlags& flags, const Options& o, const std::vector<std::s
         if (verdict[1] == '4') throw OutputError(verdict.substr(2));
         throw InputError(verdict.substr(2));
     }
-    one_thread_per_sample();
+    const OneThreadPerSample threads;
     g_interrupts = 0;
     const SignalScope signals(on_scan_signal);
     SampleQueue queue(std::move(todo), o.quiet ? -1.0 : 2.0);

@@ -25,8 +25,7 @@
 namespace fibernet::cli {
 
 namespace {
-std::atomic<bool> g_stop{false};
-extern "C" void on_signal(int) { g_stop = true; }
+extern "C" void on_signal(int) { stop_requested() = true; }
 
 const char* kHeader =
     "step,gamma,sigma_xx,sigma_xy,sigma_yy,stress_path,dsdgamma,dsdgamma_affine,energy,stretch,bend,iterations,factorizations,"
@@ -199,7 +198,11 @@ std::vector<std::pair<int, double>> truncate_csv(const std::string& path, int ro
     auto fail = [&](const std::string& m) { throw InputError("--resume: '" + path + "': " + m); };
     std::string line, kept;
     std::vector<std::pair<int, double>> steps;
-    if (!std::getline(is, line) || line != kHeader) fail("line 1 is not the sweep's CSV header");
+    if (!std::getline(is, line) || line != kHeader)
+        fail(line.find("stress_path,K,K_affine,") != std::string::npos
+                 ? "line 1 is the header of an earlier fibernet's sweep (columns K, K_affine, since renamed dsdgamma, "
+                   "dsdgamma_affine): start the sweep again"
+                 : "line 1 is not the sweep's CSV header");
     kept = line + "\n";
     for (int n = 0; n < rows; ++n) {
         if (!std::getline(is, line))
@@ -253,7 +256,7 @@ void register_sweep(CLI::App& app) {
     cmd->footer("Like `fibernet percolation --out`, the checkpoint of an unfinished sweep is refused without --resume "
                 "(its sweep would be lost); a completed sweep, or an existing CSV without a checkpoint, is replaced.");
     cmd->callback([=] {
-        g_stop = false;  // a fresh run (fibernet scan runs sweeps one after another in one process)
+        stop_requested() = false;  // a fresh run (fibernet scan runs sweeps one after another in one process)
         Scene s = flags->resolve();
         if (flags->given("--gamma")) throw InputError("command line: sweep takes --gamma-max, not --gamma");
         p->kind = s.strain;
@@ -301,7 +304,7 @@ void register_sweep(CLI::App& app) {
         std::ofstream csv(*out, std::ios::app);
         if (!csv) throw InputError("cannot append to '" + *out + "'");
         SweepCallbacks cb;
-        cb.stop = &g_stop;
+        cb.stop = &stop_requested();
         SweepState last = start;
         nlohmann::json last_step = nullptr;  // the last row written by this run, for summaries (fibernet scan)
         // The time left if the rest of the strain goes at this run's mean pace so far (rearrangements make it a guess).

@@ -1,5 +1,6 @@
 // fibernet wet: dry network -> relax -> wet -> relax under capillary load (issue 6). JSON summary on stdout; with
-// -o DIR also summary.json, sweep.csv, pores.csv, network.svg (dry | wet) and pores.svg (pore-size distributions).
+// -o DIR also summary.json, sweep.csv, pores.csv, network.svg (dry | wet), pores.svg (pore-size distributions) and
+// state_<k>.txt and state_<k>.vtp, beta k's wet equilibrium as a model file and for ParaView (with its bridges).
 // With --free-box (or [wet] free_box = true) each beta's wet state is then taken to its zero-stress box (drying
 // shrinkage; docs/wet.md, "Free box"), one progress line per outer iteration on stderr.
 // Exit 1 when a relaxation did not reach a stable equilibrium or the free box did not converge (results still
@@ -20,6 +21,8 @@
 #include <sstream>
 
 #include "common.hpp"
+#include "fibernet/export/vtp.hpp"
+#include "fibernet/model/model_io.hpp"
 #include "fibernet/energy/capillary.hpp"
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/util/error.hpp"
@@ -245,7 +248,8 @@ void register_wet(CLI::App& app) {
     // Split by parse_betas, not by CLI11's delimiter, which drops empty entries.
     cmd->add_option("--betas", w->betas, "a beta sweep, comma-separated, e.g. --betas 0,0.1,0.3,1 (overrides --beta)");
     cmd->add_option("-o,--out-dir", w->out,
-                    "write summary.json, sweep.csv, pores.csv, network.svg, pores.svg here (created if missing)");
+                    "write summary.json, sweep.csv, pores.csv, network.svg, pores.svg and each beta's wet equilibrium "
+                    "state_<k>.txt (a model file) and state_<k>.vtp (ParaView) here (created if missing)");
     cmd->add_flag("--no-moduli", w->no_moduli, "skip the dry and wet shear moduli");
     auto* o_ms = cmd->add_option("--modulus-strain", w->modulus_strain,
                                  "shear strain h of the moduli's second difference of relaxed energies at +-h, "
@@ -375,13 +379,21 @@ void register_wet(CLI::App& app) {
         const std::string dir = w->out.empty() ? "" : w->out + "/";
         auto checkpoint = [&](size_t k) {
             if (!dir.empty()) {
-                if (k == 0)  // drawn at the end only; until then no pictures of another run
-                    for (const char* f : {"network.svg", "pores.svg"}) {
-                        std::error_code ec;
+                if (k == 0) {  // drawn at the end only; until then no pictures (or states) of another run
+                    std::vector<std::string> stale = {"network.svg", "pores.svg"};
+                    std::error_code ec;
+                    for (const auto& f : std::filesystem::directory_iterator(dir, ec)) {
+                        const std::string n = f.path().filename().string();
+                        const std::string ext = n.size() > 10 ? n.substr(n.size() - 4) : "";
+                        if (n.rfind("state_", 0) == 0 && (ext == ".txt" || ext == ".vtp"))
+                            stale.push_back(n);
+                    }
+                    for (const auto& f : stale) {
                         std::filesystem::remove(dir + f, ec);
                         if (ec) throw InputError("--out-dir '" + w->out + "': cannot remove the previous " + f + " (" +
                                                  ec.message() + ")");
                     }
+                }
                 // The tables first, the summary last: a summary never lists a beta whose rows are not written yet.
                 write_file_atomic(dir + "sweep.csv", sweep.str());
                 write_file_atomic(dir + "pores.csv", pore_csv.str());
@@ -533,6 +545,25 @@ void register_wet(CLI::App& app) {
             // Finished betas survive an interrupt: the tables and summary.json (complete: false) are rewritten
             // (atomically) after each one; the pictures and stdout come at the end. After the last beta the handler
             // stays held off: the results are complete.
+            // The wet equilibrium itself (model file, docs/formats.md): the fibers' state, exact; its bridges are in
+            // the summary's counts and the pictures.
+            if (!dir.empty() && r.wet.converged) {
+                const NetworkEnergy e(m);
+                std::ostringstream state;
+                write_model(state, m, e.displacements(r.wet.q, F), F);
+                const std::string name = "state_" + std::to_string(k) + ".txt";
+                write_file_atomic(dir + name, state.str());
+                runs.back()["state"] = name;
+                // The same for ParaView, with the bridges as vertices (docs/formats.md, "VTK").
+                VtpFields vf;
+                const Eigen::VectorXd x = e.positions(r.wet.q, F);
+                for (const Bridge& b : r.active.bridges)
+                    vf.bridges.push_back(bridge_point(m, b, x, F * m.box.B0())), vf.bridge_locked.push_back(b.locked);
+                vf.scalars = {{"beta", betas[k]}};
+                std::ostringstream vtp;
+                write_vtp(vtp, e, r.wet.q, F, vf);
+                write_file_atomic(dir + "state_" + std::to_string(k) + ".vtp", vtp.str());
+            }
             if (k + 1 < betas.size()) checkpoint(k + 1), release();
         }
         const nlohmann::json j = summary(true);

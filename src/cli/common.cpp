@@ -298,6 +298,11 @@ std::function<void(const std::string&)>& progress_sink() {
     return sink;
 }
 
+std::atomic<bool>& stop_requested() {
+    static std::atomic<bool> stop{false};
+    return stop;
+}
+
 void progress_line(const std::string& line) {
     if (progress_sink()) progress_sink()(line);
     else std::cerr << line << "\n";

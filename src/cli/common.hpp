@@ -1,6 +1,7 @@
 #pragma once
 // Shared pieces of the `fibernet` subcommands: the scene flags every command accepts, JSON output, output files.
 #include <CLI/CLI.hpp>
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <functional>
@@ -100,6 +101,9 @@ double seconds_since(const std::chrono::steady_clock::time_point& t0);
 // A progress line of a long command (sweep steps, wet betas): to stderr, or to the sink when one is set (the Python
 // package's progress callback).
 void progress_line(const std::string& line);
+// Set to stop a long command after its step in progress (a sweep checks it): SIGINT/SIGTERM handlers and the Python
+// package's progress callback set it; a command clears it when it starts.
+std::atomic<bool>& stop_requested();
 std::function<void(const std::string&)>& progress_sink();
 
 // The command line as given (without the program name), set by main: recorded in results for provenance.

@@ -21,13 +21,24 @@ void register_commands(CLI::App& app) {
     register_scan(app);
 }
 
+namespace {
+std::string help_text(CLI::App& app) {
+    for (CLI::App* sub : app.get_subcommands()) return sub->help();
+    return app.help();
+}
+}  // namespace
+
 CommandOutcome run_command(CLI::App& app, const std::vector<std::string>& argv, bool with_provenance) {
     CommandOutcome out;
     // The capture, the exit code and the recorded command line are the process's: put them back however this ends.
+    // (A scan run from Python nests: its samples' captures must leave the scan's own in place.)
     struct Restore {
         std::vector<std::string> argv = command_argv();
+        nlohmann::json* capture = json_capture();
+        bool provenance = capture_provenance();
+        int code = exit_code();
         ~Restore() {
-            json_capture() = nullptr, capture_provenance() = false, exit_code() = 0;
+            json_capture() = capture, capture_provenance() = provenance, exit_code() = code;
             command_argv() = argv;
         }
     } restore;
@@ -40,6 +51,10 @@ CommandOutcome run_command(CLI::App& app, const std::vector<std::string>& argv, 
     try {
         app.parse(reversed);
         out.exit_code = exit_code();
+    } catch (const CLI::CallForHelp&) {  // --help: the command's help as the result
+        out.result = {{"help", help_text(app)}};
+    } catch (const CLI::CallForAllHelp&) {
+        out.result = {{"help", help_text(app)}};
     } catch (const CLI::ParseError& e) {
         throw InputError(std::string("the arguments of ") + (argv.empty() ? "fibernet" : argv[0]) + ": " + e.what());
     } catch (const InputError&) {

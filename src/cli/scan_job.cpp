@@ -25,7 +25,7 @@ const std::map<std::string, Registrar>& registrars() {
 const std::set<std::string>& reserved() {
     static const std::set<std::string> r = [] {
         std::set<std::string> names = {"-o",    "--out",     "--out-dir",    "--output", "--svg", "--table", "--summary",
-                                       "--checkpoint", "--resume", "-v", "--verbose", "-q", "--quiet"};
+                                       "--checkpoint", "--resume", "--vtk", "-v", "--verbose", "-q", "--quiet"};
         CLI::App app;
         SceneFlags flags;
         flags.add(app.add_subcommand("any"), true, true);

@@ -107,7 +107,7 @@ void write_input(std::ostream& os, const Model& m, const BoxBounds& b, double cu
     os << (m.box.periodic ? "boundary p p p\n" : "boundary f f p\n");
     if (m.box.periodic && std::abs(b.xy) > 0.5 * (b.xhi - b.xlo)) os << "box tilt large\n";
     os << "bond_style harmonic\nangle_style cosine\n";
-    os << "read_data " << data_name << "\n";
+    os << "read_data " << data_name << "  # relative to the directory lmp runs in\n";
     // No pair forces; the zero pair style and the communication cutoff only make every bond's and angle's atoms
     // ghosts of each other (an angle spans two bonds).
     os << "pair_style zero " << cutoff << "\npair_coeff * *\n";

@@ -156,6 +156,12 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* u
         } else {
             u[2 * i] = r.num(ss, "node ux"), u[2 * i + 1] = r.num(ss, "node uy");
         }
+        // A node a thousand boxes away is no state of this network (and its energy overflows).
+        const double reach = 1e3 * (std::abs(m.box.L) + std::abs(m.fiber_length));
+        for (double v : {m.x[2 * i], m.x[2 * i + 1], u[2 * i], u[2 * i + 1]})
+            if (!(std::abs(v) <= reach))
+                r.fail("node " + std::to_string(i) + ": coordinate " + show(v) + " lies beyond 1000 box sides (" +
+                       show(reach) + ")");
     }
     const long ns = r.section("segments");
     m.segments.resize(ns);

@@ -6,7 +6,6 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
-#include <csignal>
 #include <fstream>
 #include <mutex>
 #include <optional>
@@ -119,8 +118,8 @@ std::mutex& command_mutex() {
 }
 
 // progress: None, or a callable given each progress line (sweep steps, wet betas) while the command runs. An exception
-// it raises ends the calls to it, stops a sweep after its step (as SIGINT does) and is raised again once the command
-// has returned.
+// it raises ends the calls to it, stops a sweep after its step (as Ctrl-C does; other commands run to their end) and
+// is raised again once the command has returned.
 py::tuple run(const std::vector<std::string>& argv, py::object progress) {
     cli::CommandOutcome o;
     std::optional<py::error_already_set> callback_error;
@@ -135,7 +134,7 @@ py::tuple run(const std::vector<std::string>& argv, py::object progress) {
                     progress(line);
                 } catch (py::error_already_set& e) {
                     callback_error.emplace(std::move(e));
-                    std::raise(SIGINT);  // a sweep's handler stops it after this step, as Ctrl-C does
+                    cli::stop_requested() = true;  // a sweep stops after this step, as on Ctrl-C
                 }
             };
         struct ResetSink {

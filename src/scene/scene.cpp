@@ -212,7 +212,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
             std::vector<std::string> generation;  // generation keys given (they have no effect with a file)
             for (const char* k : {"L", "q", "pl", "seed", "periodic"})
                 if (r.t.get(k)) generation.push_back(k);
-            if (!s.network_file.empty() && !generation.empty())
+            if (r.t.get("file") && !generation.empty())
                 throw InputError(source + ": [network].file = '" + s.network_file + "' is given with [network]." +
                                  generation.front() + ": a saved network brings its own box and fibers (remove one)");
         }

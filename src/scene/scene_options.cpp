@@ -177,7 +177,8 @@ void SceneOption::set_from_text(Scene& s, const std::string& t, const std::strin
         }
         case OptionKind::Integer: {
             long v = 0;
-            const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+            const size_t skip = t.size() > 1 && t[0] == '+' && t[1] != '-' ? 1 : 0;  // "+5", as before
+            const auto r = std::from_chars(t.data() + skip, t.data() + t.size(), v);
             if (r.ec != std::errc() || r.ptr != t.data() + t.size() || v < INT_MIN || v > INT_MAX)
                 throw InputError(what + " is not an integer in [" + std::to_string(INT_MIN) + ", " +
                                  std::to_string(INT_MAX) + "]");

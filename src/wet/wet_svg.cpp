@@ -14,6 +14,21 @@ std::string color_of(int label) {
 }
 }  // namespace
 
+Eigen::Vector2d bridge_point(const Model& m, const Bridge& b, const Eigen::VectorXd& x, const Eigen::Matrix2d& B) {
+    const BridgeElement el = resolve(m, b);
+    const Vector16d Z = element_coordinates(el, x, B);
+    const Eigen::Vector2d p1 = Z.segment<2>(2), d1 = Z.segment<2>(4) - p1, p2 = Z.segment<2>(10), d2 = Z.segment<2>(12) - p2;
+    const double den = d1.x() * d2.y() - d1.y() * d2.x();
+    double t = 0.5;  // parallel segments: the middle of the first
+    if (std::abs(den) > 1e-12 * d1.norm() * d2.norm()) {
+        const Eigen::Vector2d w = p2 - p1;
+        t = std::min(1.5, std::max(-0.5, (w.x() * d2.y() - w.y() * d2.x()) / den));
+    }
+    Eigen::Vector2d c = p1 + t * d1;
+    if (m.box.periodic) c -= B * (B.inverse() * c).array().floor().matrix();
+    return c;
+}
+
 namespace {
 // A bar one fiber length long (at the panels' scale) and what the marks mean, on one line at height y.
 std::string scale_and_legend(const Model& m, double px, double gap, double y) {
@@ -86,17 +101,7 @@ std::string network_svg(const Model& m, const std::vector<SvgPanel>& panels, dou
             }
         }
         for (const Bridge& b : P.bridges) {
-            const BridgeElement el = resolve(m, b);
-            const Vector16d Z = element_coordinates(el, P.x, P.B);
-            const Eigen::Vector2d p1 = Z.segment<2>(2), d1 = Z.segment<2>(4) - p1, p2 = Z.segment<2>(10), d2 = Z.segment<2>(12) - p2;
-            const double den = d1.x() * d2.y() - d1.y() * d2.x();
-            double t = 0.5;
-            if (std::abs(den) > 1e-12 * d1.norm() * d2.norm()) {
-                const Eigen::Vector2d w = p2 - p1;
-                t = std::min(1.5, std::max(-0.5, (w.x() * d2.y() - w.y() * d2.x()) / den));
-            }
-            Eigen::Vector2d c = p1 + t * d1;
-            if (m.box.periodic) c -= P.B * (Bi * c).array().floor().matrix();
+            const Eigen::Vector2d c = bridge_point(m, b, P.x, P.B);
             os << "<circle cx=\"" << X(c) << "\" cy=\"" << Y(c) << "\" r=\"" << (b.locked ? 1.3 : 2.2) << "\" fill=\""
                << (b.locked ? "#d62728" : "#ff4d4d") << "\"/>\n";
         }

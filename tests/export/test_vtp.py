@@ -72,3 +72,23 @@ def test_sweep_series(tmp_path, cli):
     for d, g in zip(steps, gammas):
         _, _, _, field = read_vtp(tmp_path / "vtk" / d.get("file"))
         assert field["gamma"] == g and "dsdgamma" in field
+
+
+def test_wet_state_with_bridges(tmp_path, cli):
+    code, out, err = cli("wet", "--L", 3, "--q", 6, "--scheme", "even", "--betas", 0.1, "--no-moduli", "-q",
+                         "-o", tmp_path / "wet")
+    assert code == 0, err
+    run = out["runs"][0]
+    poly, cells, points, field = read_vtp(tmp_path / "wet" / "state_0.vtp")
+    nb = run["bridges"]["final"]
+    assert poly.GetNumberOfVerts() == nb and nb > 0
+    assert set(cells["bridge"][:nb]) <= {1, 2} and not cells["bridge"][nb:].any()
+    assert (cells["fiber"][:nb] == -1).all() and (cells["fiber"][nb:] >= 0).all()
+    assert field["beta"] == 0.1
+    # The fibers' part of the wet energy, cell by cell.
+    assert cells["stretch_energy"].sum() == pytest.approx(run["energy"]["wet"]["stretch"], rel=1e-9)
+    assert cells["bend_energy"].sum() == pytest.approx(run["energy"]["wet"]["bend"], rel=1e-9)
+    # The model-file state beside it is the same equilibrium.
+    st = fn.load_state(tmp_path / "wet" / run["state"])
+    e = st.energy()
+    assert e["stretch"] == pytest.approx(run["energy"]["wet"]["stretch"], rel=1e-12)

@@ -109,6 +109,9 @@ def test_rigidity_and_wet():
     w = fn.wet(L=3, q=6, seed=1, scheme="even", betas="0,0.1", no_moduli=True)
     assert w["exit_code"] == 0 and list(w["sweep"]["beta"]) == [0, 0.1]
     assert len(w["pores"]["area"]) > 0
+    for run in w["runs"]:  # the wet equilibria, exact: their energies are the dry part of the summary's
+        st = run["state"]
+        assert st is not None and st.u.shape == (st.model.num_nodes, 2)
 
 
 @pytest.mark.parametrize("kwargs, named", [
@@ -154,3 +157,35 @@ def test_sweep_progress_callback():
         raise KeyboardInterrupt("enough")
     with pytest.raises(KeyboardInterrupt):
         fn.sweep(L=3, q=8, seed=1, scheme="even", gamma_max=0.03, progress=stop)
+
+
+def test_recorded_command_reruns(cli):
+    """The provenance's command line, run by a shell as written, gives the same result."""
+    import shlex
+    py = fn.modulus(**SCENE)
+    words = shlex.split(py["provenance"]["command"])
+    assert words[0] == "fibernet"
+    code, out, _ = cli(*words[1:])
+    assert code == 0
+    assert abs(out["moduli"]["G"] - py["moduli"]["G"]) <= 2 * py["moduli"]["G_error"]
+    assert out["provenance"]["scene_toml"] == py["provenance"]["scene_toml"]
+
+
+def test_scan_from_python_returns_its_result(tmp_path):
+    """A scan runs its samples in process too: their captures nest inside the scan's."""
+    code, out = fn.run("scan", "--L", 3, "--q", 6, "--open", "--scheme", "even", "--vary", "seed=1,2",
+                       "--job", "rigidity", "-o", tmp_path / "sc", "-q")
+    assert code == 0 and out is not None and out["samples"] == 2
+    assert (tmp_path / "sc" / "samples.csv").exists()
+
+
+def test_help_is_a_result():
+    code, out = fn.run("modulus", "--help")
+    assert code == 0 and "--gamma" in out["help"]
+
+
+def test_wet_progress_callback_error_is_raised():
+    def fail(line):
+        raise RuntimeError("from the callback")
+    with pytest.raises(RuntimeError, match="from the callback"):
+        fn.wet(L=3, q=6, scheme="even", betas="0,0.1", no_moduli=True, progress=fail)

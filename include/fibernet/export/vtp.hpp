@@ -5,6 +5,7 @@
 // stretch_energy, bend_energy (each hinge's energy split half and half between its two segments, so the cells sum to
 // the total), and any per-fiber integer fields given (e.g. rigid_cluster). Point data: node (its model index),
 // displacement u = x - x_ref, crosslink (1 at a supernode). Field data: the scalars given (gamma, energy, ...).
+// Bridges, if given, are vertex cells of their own (VtpFields::bridges).
 #include <Eigen/Core>
 #include <iosfwd>
 #include <string>
@@ -18,6 +19,10 @@ namespace fibernet {
 struct VtpFields {
     std::vector<std::pair<std::string, std::vector<int>>> per_fiber;  // name, one value per fiber id
     std::vector<std::pair<std::string, double>> scalars;              // written as FieldData
+    // Capillary bridges (a wet state): one vertex cell each, before the segments' line cells (VTK's cell order).
+    // Their cells have bridge = 1 (2: locked), fiber = -1 and zero segment fields; the segments' have bridge = 0.
+    std::vector<Eigen::Vector2d> bridges;
+    std::vector<int> bridge_locked;
 };
 
 // The state q (free coordinates of e) at deformation F.

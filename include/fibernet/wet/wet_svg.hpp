@@ -22,6 +22,9 @@ struct SvgPanel {
 
 std::string network_svg(const Model& m, const std::vector<SvgPanel>& panels, double pixels = 420);
 
+// Where a bridge is drawn: the crossing point of its two segments' lines (clamped near the first segment), in the box.
+Eigen::Vector2d bridge_point(const Model& m, const Bridge& b, const Eigen::VectorXd& x, const Eigen::Matrix2d& B);
+
 // Histograms of `values` per series (same bins), as outlined bars; x label, log-spaced bins if log_bins.
 std::string histogram_svg(const std::vector<std::string>& names, const std::vector<std::vector<double>>& values,
                           const std::string& xlabel, int bins = 20);
