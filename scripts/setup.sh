@@ -2,7 +2,8 @@
 # Installs fibernet's build dependencies from Debian 12's packages (only what is missing), then builds.
 # Usage: scripts/setup.sh [--no-build | --all]
 #   default: build only the fibernet executable (the README's main job needs nothing else);
-#   --all: also the tests and benchmarks (scripts/test.sh); --no-build: install packages only.
+#   --all: also the Python package, the tests and benchmarks (scripts/test.sh); --no-build: install packages only.
+#   (The Python package alone: cmake --build build --target _fibernet; docs/python.md.)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 pkgs=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libopenblas-dev
@@ -33,8 +34,4 @@ if [ "$mode" = "--all" ]; then
   cmake --build build -j"$(nproc)" >&2
 else
   cmake --build build -j"$(nproc)" --target fibernet >&2
-  # The Python package too, where pybind11 was found (PYTHONPATH=build/python; docs/python.md).
-  if cmake --build build --target help 2>/dev/null | grep -q "_fibernet"; then
-    cmake --build build -j"$(nproc)" --target _fibernet >&2
-  fi
 fi
