@@ -32,6 +32,23 @@ const char* kHeader =
     "retries,grad_max,seconds";
 constexpr size_t kColumns = 16;
 
+// A progress line per step, with the time left if the rest of the strain goes at this run's mean pace so far
+// (rearrangements make it a guess).
+struct StepLines {
+    double t_first, t_max;
+    std::chrono::steady_clock::time_point t_run = std::chrono::steady_clock::now();
+    StepLines(double first, double last) : t_first(first), t_max(last) {}
+    void step(const SweepRow& r) const {
+        std::ostringstream line;
+        line << "sweep: step " << r.step << "  gamma = " << r.t << "  s = " << r.stress_path << "  ds/dgamma = " << r.K
+             << "  iterations = " << r.iterations << "  retries = " << r.retries << "  " << r.seconds << " s";
+        const double done = std::abs(r.t - t_first), left = std::abs(t_max - r.t);
+        if (done > 0 && left > 0)
+            line << std::fixed << std::setprecision(2) << "  ETA " << seconds_since(t_run) * left / done << " s";
+        progress_line(line.str());
+    }
+};
+
 // The CSV's columns, for its sidecar (docs/sweep.md).
 nlohmann::json column_docs() {
     return {{"step", "accepted step, 0 = the reference"},
@@ -307,17 +324,7 @@ void register_sweep(CLI::App& app) {
         cb.stop = &stop_requested();
         SweepState last = start;
         nlohmann::json last_step = nullptr;  // the last row written by this run, for summaries (fibernet scan)
-        // The time left if the rest of the strain goes at this run's mean pace so far (rearrangements make it a guess).
-        const auto t_run = std::chrono::steady_clock::now();
-        const double t_first = start.t;
-        auto eta = [&](double t) -> std::string {
-            const double done = std::abs(t - t_first), left = std::abs(p->t_max - t);
-            if (done <= 0 || left <= 0) return "";
-            std::ostringstream os;
-            os.precision(2);
-            os << "  ETA " << std::fixed << seconds_since(t_run) * left / done << " s";
-            return os.str();
-        };
+        const StepLines lines(start.t, p->t_max);
         cb.on_step = [&](const SweepRow& r, const SweepState& st) {
             last_step = {{"step", r.step},       {"gamma", r.t},          {"sigma_xx", r.sigma(0, 0)},
                          {"sigma_xy", r.sigma(0, 1)}, {"sigma_yy", r.sigma(1, 1)}, {"stress_path", r.stress_path},
@@ -329,13 +336,7 @@ void register_sweep(CLI::App& app) {
                            {{}, {{"gamma", r.t}, {"stress_path", r.stress_path}, {"dsdgamma", r.K}, {"energy", r.energy}}});
             write_checkpoint(*ckpt, params, ++rows, st);
             last = st;
-            if (!*quiet) {
-                std::ostringstream line;
-                line << "sweep: step " << r.step << "  gamma = " << r.t << "  s = " << r.stress_path
-                     << "  ds/dgamma = " << r.K << "  iterations = " << r.iterations << "  retries = " << r.retries
-                     << "  " << r.seconds << " s" << eta(r.t);
-                progress_line(line.str());
-            }
+            if (!*quiet) lines.step(r);
         };
         // Ctrl-C and SIGTERM end the sweep after the step in progress, unless the caller ignores them (a background
         // job of a script inherits SIGINT ignored): that disposition is kept.
