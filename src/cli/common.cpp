@@ -103,8 +103,8 @@ void SceneFlags::add(CLI::App* app, bool with_load, bool with_wet) {
         if ((o.table == "load" || o.table == "solver") && !with_load) continue;
         if (o.table == "wet" && !with_wet) continue;
         std::string doc = o.doc;
-        if (o.kind != OptionKind::Boolean && !(o.kind == OptionKind::Text && o.text(const_cast<Scene&>(defaults)).empty()))
-            doc += " (default " + o.literal(defaults) + ")";
+        const std::string shown = o.literal(defaults);  // no default shown for a switch or an empty text
+        if (o.kind != OptionKind::Boolean && shown != "\"\"") doc += " (default " + shown + ")";
         CLI::Option* cli = o.kind == OptionKind::Boolean ? app->add_flag(o.flag, switches[o.flag], doc)
                                                          : app->add_option(o.flag, values[o.flag], doc);
         if (o.kind == OptionKind::Real) cli->type_name("NUMBER");
