@@ -207,13 +207,15 @@ double NetworkEnergy::hinge_term(int e, const Eigen::VectorXd& u, const Eigen::M
 void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F, const Eigen::Matrix2d& dF,
                              unsigned want, EnergyEval& out, Eigen::SparseMatrix<double>* H) const {
     const bool wg = want & kGradient, wh = want & kHessian, ws = want & kStrain, psd = want & kProjectPSD;
+    const bool comoving = ws && (want & kComoving);
+    const Eigen::Matrix2d V = comoving ? Eigen::Matrix2d(dF * F.inverse()) : Eigen::Matrix2d::Zero();
     const Eigen::VectorXd u = displacements(q, F);
     const Eigen::Matrix2d FmI = F - Eigen::Matrix2d::Identity();
     const Eigen::Matrix2d dB = dF * model_.box.B0(), FmIB0 = FmI * model_.box.B0();
     const double k4a2 = 4 * model_.aspect_ratio * model_.aspect_ratio;
     const bool any_fixed = ndof_ != static_cast<int>(dof_.size());
     out.energy = out.stretch = out.bend = 0;
-    out.dE_dt = out.d2E_dt2 = 0;
+    out.dE_dt = out.d2E_dt2 = out.d2E_dt2_size = 0;
     if (wg) out.gradient.setZero(ndof_);
     if (ws) out.d2E_dqdt.setZero(ndof_);
     double* hv = nullptr;
@@ -227,11 +229,15 @@ void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
         if (d0 >= 0) v[d0] += g.x(), v[d0 + 1] += g.y();
     };
     // Edge vector d = d0 + (F - I) B0 n + u_j - u_i (= x_j - x_i + F B0 n) and its strain rate
-    // dd/dt = dF (B0 n + [fixed] x_ref differences).
+    // dd/dt = dF (B0 n + [fixed] x_ref differences), or dF F^-1 d when every node moves affinely (kComoving).
     auto edge = [&](int i, int j, const Eigen::Vector2i& n, const Eigen::Vector2d& d0, Eigen::Vector2d& d,
                     Eigen::Vector2d& c) {
         d = d0 + FmIB0 * n.cast<double>() + (u.segment<2>(2 * j) - u.segment<2>(2 * i));
         if (!ws) return;
+        if (comoving) {
+            c = V * d;
+            return;
+        }
         c = dB * n.cast<double>();
         if (any_fixed) {
             if (dof_[2 * j] < 0) c += dF * model_.x.segment<2>(2 * j);
@@ -250,7 +256,9 @@ void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
         if (wg) add_grad(out.gradient, s.i, -gd), add_grad(out.gradient, s.j, gd);
         if (ws) {
             out.dE_dt += gd.dot(c);
-            out.d2E_dt2 += c.dot(Hd * c);
+            const double tt = c.dot(Hd * c);
+            out.d2E_dt2 += tt;
+            out.d2E_dt2_size += std::abs(tt);
             const Eigen::Vector2d hc = Hd * c;
             add_grad(out.d2E_dqdt, s.i, -hc), add_grad(out.d2E_dqdt, s.j, hc);
         }
@@ -285,7 +293,9 @@ void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
             Eigen::Vector4d c4;
             c4 << c1, c2;
             out.dE_dt += g4.dot(c4);
-            out.d2E_dt2 += c4.dot(H4 * c4);
+            const double tt = c4.dot(H4 * c4);
+            out.d2E_dt2 += tt;
+            out.d2E_dt2_size += std::abs(tt);
             const Eigen::Vector4d hc = H4 * c4;
             add_grad(out.d2E_dqdt, h.i, -hc.head<2>());
             add_grad(out.d2E_dqdt, h.j, hc.head<2>() - hc.tail<2>());

@@ -52,13 +52,17 @@ bool relaxed_at(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::M
     Eigen::SparseMatrix<double> H = e.hessian_pattern();
     EnergyEval ev;
     double gmax = 0;
+    std::vector<double> E_tt_size(modes.size());
     for (size_t m = 0; m < modes.size(); ++m) {
         const bool first = m == 0;
-        e.evaluate(q, F, modes[m].dF, kStrain | (first ? kHessian | kGradient : 0u), ev, first ? &H : nullptr);
+        // Comoving strain derivatives from the elements' own edge vectors (kComoving): E_tt + 2 v.b + v.H v formed
+        // from H v loses (|v| |H| |v|) eps to H's stiff entries, 5e-5 of c on the seed scheme at L = 40.
+        e.evaluate(q, F, modes[m].dF, kStrain | kComoving | (first ? kHessian | kGradient : 0u), ev, first ? &H : nullptr);
         if (first) grad = ev.gradient;
         if (first && n > 0) gmax = ev.gradient.cwiseAbs().maxCoeff();
         out[m].name = modes[m].name;
         out[m].E_tt = ev.d2E_dt2;
+        E_tt_size[m] = ev.d2E_dt2_size;
         b[m] = ev.d2E_dqdt;
     }
     const double seconds_assembly = since(t0);
@@ -86,7 +90,7 @@ bool relaxed_at(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::M
     const Eigen::VectorXd x = e.positions(q, F);  // absolute positions: the affine velocity is dF F^-1 x
     std::vector<StrainTerms> terms(modes.size());
     for (size_t m = 0; m < modes.size(); ++m)
-        terms[m] = {out[m].E_tt, std::move(b[m]), affine_velocity(e, x, modes[m].dF * F.inverse())};
+        terms[m] = {out[m].E_tt, std::move(b[m]), affine_velocity(e, x, modes[m].dF * F.inverse()), true, E_tt_size[m]};
     std::vector<Modulus> relaxed = relaxed_moduli(H, terms, modes, opt, &inf, &llt);
     for (size_t m = 0; m < modes.size(); ++m) relaxed[m].name = out[m].name;
     out = std::move(relaxed);
@@ -96,36 +100,28 @@ bool relaxed_at(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::M
     return true;
 }
 
-// Affine predictions: d2E/dt2 along the affine path x(t) = F(t) x_ref with no relaxation: at the affinely deformed
-// reference q_a, E_tt + 2 v.E_xt + v.H v with v = dF F^{-1} x the affine velocity (one more assembly). This is not the
-// fixed-q E_tt, which (q fixed = positions fixed) holds only the terms of box-crossing segments. At the affine state
-// itself (the straight reference at F = I is one) the comoving E_tt of `relaxed` already is the prediction.
+// Affine predictions: d2E/dt2 along the affine path x(t) = F(t) x_ref with no relaxation: the comoving d2E/dt2
+// (kComoving) at the affinely deformed reference q_a. This is not the fixed-q E_tt, which (q fixed = positions fixed)
+// holds only the terms of box-crossing segments. At the affine state itself (the straight reference at F = I is one)
+// the comoving E_tt of `relaxed` already is the prediction.
 void affine_predictions(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
                         const std::vector<StrainMode>& modes, std::vector<Modulus>& relaxed) {
     const int n = e.num_dofs();
-    if (n == 0) {
-        for (size_t m = 0; m < modes.size(); ++m) relaxed[m].affine = modes[m].scale * relaxed[m].E_tt;  // all fixed
+    const Eigen::VectorXd qa = n > 0 ? affine_start(e, F) : Eigen::VectorXd();
+    if (n == 0 || (qa - q).lpNorm<Eigen::Infinity>() <= 1e-10) {  // all fixed, or q is the affine state (to
+        for (size_t m = 0; m < modes.size(); ++m) relaxed[m].affine = modes[m].scale * relaxed[m].E_tt;  // round-off)
         return;
     }
-    const Eigen::VectorXd qa = affine_start(e, F);
-    if ((qa - q).lpNorm<Eigen::Infinity>() <= 1e-10) {  // positions equal to 1e-10 seed units: Newton's round-off moves
-        for (size_t m = 0; m < modes.size(); ++m) relaxed[m].affine = modes[m].scale * relaxed[m].E_tt;
-        return;
-    }
-    Eigen::SparseMatrix<double> Ha = e.hessian_pattern();
     EnergyEval ev;
-    const Eigen::VectorXd xa = e.positions(qa, F);  // q are displacements: the velocity needs positions
     for (size_t m = 0; m < modes.size(); ++m) {
-        e.evaluate(qa, F, modes[m].dF, kStrain | (m == 0 ? kHessian : 0u), ev, m == 0 ? &Ha : nullptr);
-        const Eigen::VectorXd v = affine_velocity(e, xa, modes[m].dF * F.inverse());
-        const Eigen::VectorXd Hv = Ha.selfadjointView<Eigen::Upper>() * v;
-        relaxed[m].affine = modes[m].scale * (ev.d2E_dt2 + 2 * v.dot(ev.d2E_dqdt) + v.dot(Hv));
+        e.evaluate(qa, F, modes[m].dF, kStrain | kComoving, ev);
+        relaxed[m].affine = modes[m].scale * ev.d2E_dt2;
     }
 }
 
 // The state's share of the error: q is an equilibrium only to the solver's tolerance or its round-off floor, and the
 // moduli move with it (a seed-scheme G of -1.8e-8 at one Newton equilibrium, -4.3e-7 at another equally converged
-// one). One Newton step from q, q' = q - (H + delta I)^{-1} g with the factorization the moduli used, is as good an
+// one). One Newton step from q, q' = q - (H + delta D)^{-1} g with the factorization the moduli used, is as good an
 // equilibrium (quadratically closer, or as close at the floor); the moduli there differ from those at q by what the
 // state leaves, and that difference joins each error (one more assembly, factorization and CG).
 void state_error(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
@@ -187,7 +183,7 @@ struct ModeCG {
     int steps = 0;
     bool conv = false, noise = false, broke = false;
 };
-// Per mode: the scale of the cancellation E_tt - c, b.M b at the start (M = (H + delta I)^-1), and the unknowns.
+// Per mode: the scale of the cancellation E_tt - c, b.M b at the start (M = (H + delta D)^-1), and the unknowns.
 struct CgScales {
     const std::vector<double>& scale_ref;
     const std::vector<double>& rz0;
@@ -195,10 +191,10 @@ struct CgScales {
     int n;
 };
 
-// Preconditioned conjugate gradients on H U = B from U = 0 with the preconditioner M = (H + delta I)^{-1}, one
+// Preconditioned conjugate gradients on H U = B from U = 0 with the preconditioner M = (H + delta D)^{-1}, one
 // independent CG per mode, all modes' preconditioner solves in one multi-column CHOLMOD call. The preconditioned
 // spectrum is lambda / (lambda + delta): 1 for every stiff mode, so CG only has to resolve the few modes with
-// lambda ~ delta (plain refinement u += (H + delta I)^{-1} (b - H u) crawls on those: measured 0.55 per step at
+// lambda ~ delta (plain refinement u += (H + delta D)^{-1} (b - H u) crawls on those: measured 0.55 per step at
 // L = 20). The iterates stay in range(H) when b does, and c_k = b.u_k rises monotonically to b.H^+ b. (Restarting
 // from the true residual B - H U was tried: on the seed scheme it chases the round-off of H U and moves c further.)
 template <class HView>
@@ -271,7 +267,9 @@ double cg_tail(const ModeCG& r) {
     if (r.broke) return std::numeric_limits<double>::infinity();
     if (r.inc == 0) return 0;
     if (r.noise) return r.inc;
-    const double rho = std::isfinite(r.prev_inc) && r.prev_inc > 0 ? r.inc / r.prev_inc : 0.0;
+    // One step gives no rate: a CG stopped there (by its step limit) has an unknown tail, unless it converged.
+    if (!(std::isfinite(r.prev_inc) && r.prev_inc > 0)) return r.conv ? 0.0 : std::numeric_limits<double>::infinity();
+    const double rho = r.inc / r.prev_inc;
     return rho < 1 ? r.inc * rho / (1 - rho) : std::numeric_limits<double>::infinity();
 }
 
@@ -289,13 +287,30 @@ double cg_error(const ModeCG& r, const CgScales& sc, int m) {
 }
 
 // The error of c = b.u that the true residual r = B - H U shows: c* - c = u.r + r.H^+ r for c* = b.H^+ b (b, H u in
-// range(H)); r.M r stands in for r.H^+ r (equal on H's stiff modes, a lower bound on the soft ones).
+// range(H)); r.M r stands in for r.H^+ r (equal on H's stiff modes, a lower bound on the soft ones). Plus what
+// rounding leaves unknown in the products with H: fl(H w) is H w only to gamma_k |H| |w| componentwise (k nonzeros
+// per row; Higham, Accuracy and Stability, eq. 3.11), for w = u (the residual) and w = v (the comoving B = b + H v and
+// E_tt + v.H v), so the modulus is uncertain by (|u| + |v|).|H|.(|u| + |v|) times the rounding of a k-term sum,
+// taken as sqrt(k) eps as for the other sums. On the seed scheme a 1e-5 segment (stiffness 1e5 a^2) puts that 1e9
+// times above u.H u; this term covers a floppy network's G of -1.1e-5 at rest (docs/moduli.md "Error estimates").
+struct ResidualError {
+    double drift = 0;     // u.r + r.M r
+    double roundoff = 0;  // sqrt(k) eps (|u| + |v|).|H|.(|u| + |v|)
+};
 template <class HView>
-std::vector<double> true_residual_correction(const HView& Hs, const CholmodLLT& llt, const Eigen::MatrixXd& B,
-                                             const Eigen::MatrixXd& U) {
+std::vector<ResidualError> true_residual_error(const HView& Hs, const Eigen::SparseMatrix<double>& H,
+                                               const CholmodLLT& llt, const Eigen::MatrixXd& B, const Eigen::MatrixXd& U,
+                                               const Eigen::MatrixXd& V) {
     const Eigen::MatrixXd R = B - Hs * U, Z = llt.solve_many(R);
-    std::vector<double> d(B.cols());
-    for (int m = 0; m < B.cols(); ++m) d[m] = U.col(m).dot(R.col(m)) + R.col(m).dot(Z.col(m));
+    const Eigen::SparseMatrix<double> Habs = H.cwiseAbs();
+    const Eigen::MatrixXd W = U.cwiseAbs() + V.cwiseAbs(), HW = Habs.selfadjointView<Eigen::Upper>() * W;
+    const double per_row = H.rows() > 0 ? (2.0 * H.nonZeros() - H.rows()) / H.rows() : 1.0;  // of the full symmetric H
+    const double rounding = std::sqrt(std::max(per_row, 1.0)) * std::numeric_limits<double>::epsilon();
+    std::vector<ResidualError> d(B.cols());
+    for (int m = 0; m < B.cols(); ++m) {
+        d[m].drift = U.col(m).dot(R.col(m)) + R.col(m).dot(Z.col(m));
+        d[m].roundoff = rounding * W.col(m).dot(HW.col(m));
+    }
     return d;
 }
 
@@ -335,21 +350,24 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
         inf.seconds_total = since(t_start);
         return out;
     }
-    // Shift scale: first the median |diagonal|; the mean, which a few segments of 1e-5 (stiffness 1/l) inflate by
-    // 1e2..1e5 at L = 80, leaves many soft modes below the shift for the CG (measured at L = 80: 23 and 15 steps
-    // against 3 and 12, and a K whose CG stopped 2e-3 short of the median-shift value with a bound of 6e-5). With the
-    // smaller shift, round-off in the null space of a floppy network can stop the CG before it converges; then the
-    // solve is repeated with the mean scale, at least 100x the median (one more factorization).
+    // The shift is relative to each coordinate's own stiffness, H + delta D with D = |diag H| (a Jacobi-scaled
+    // shift): Cholesky's rounding is relative to the diagonal (Demmel 1989: it succeeds once the scaled matrix's
+    // smallest eigenvalue is above ~n eps), so delta D factors at delta = 1e-12 where a uniform shift of 1e-12 the
+    // median |diagonal| failed on the seed scheme's 1e-5 segments (stiffness 1e5 the median) and had to grow to 1e-4,
+    // which left the CG hundreds of soft modes (L = 40: modulus_failed; now 136 steps, docs/moduli.md). D is floored
+    // at 1e-12 of the median so that a coordinate without stiffness still gets a shift.
     std::vector<double> diag(n);
     for (int j = 0; j < n; ++j) diag[j] = std::abs(H.coeff(j, j));
-    const double mean_scale = std::max(std::accumulate(diag.begin(), diag.end(), 0.0) / n, std::numeric_limits<double>::min());
-    std::nth_element(diag.begin(), diag.begin() + n / 2, diag.end());
-    const double median_scale = std::max(diag[n / 2], std::numeric_limits<double>::min());
+    std::vector<double> sorted = diag;
+    std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+    const double d_floor = std::max(1e-12 * sorted[n / 2], std::numeric_limits<double>::min());
+    for (double& d : diag) d = std::max(d, d_floor);
     // The right-hand sides in comoving coordinates, the same for both shift scales below.
     auto t0 = Clock::now();
     const auto Hs = H.selfadjointView<Eigen::Upper>();
     const int M = static_cast<int>(modes.size());
     Eigen::MatrixXd B(n, M), V(n, M);
+    Eigen::MatrixXd Vround = Eigen::MatrixXd::Zero(n, M);  // v where B and E_tt were formed through H v (rounding)
     std::vector<double> comoving_size(M);
     for (int m = 0; m < M; ++m) {
         // Comoving (affine) coordinates: with v = dF F^{-1} x the affine velocity of the free nodes,
@@ -357,28 +375,36 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
         // whose two terms are the affine and non-affine parts: O(G A) instead of O(L^2 k) with absolute
         // coordinates, where box-crossing segments make E_tt ~ 1e8 and the cancellation costs 6 digits.
         const Eigen::VectorXd& v = terms[m].v;
+        V.col(m) = v;
+        if (terms[m].comoving) {  // formed per element already
+            comoving_size[m] = std::max(terms[m].E_tt_size, std::abs(out[m].E_tt));
+            B.col(m) = terms[m].b;
+            continue;
+        }
         const Eigen::VectorXd Hv = Hs * v;
         comoving_size[m] = std::abs(out[m].E_tt) + 2 * v.cwiseProduct(terms[m].b).cwiseAbs().sum() +
                            v.cwiseProduct(Hv).cwiseAbs().sum();  // what the comoving E_tt's sum cancels
         out[m].E_tt += 2 * v.dot(terms[m].b) + v.dot(Hv);
         B.col(m) = terms[m].b + Hv;
-        V.col(m) = v;
+        Vround.col(m) = v;
     }
     const double seconds_setup = since(t0);
     const std::vector<Modulus> base = out;
     CholmodLLT own;
     CholmodLLT& llt = shared_llt ? *shared_llt : own;
-    auto attempt = [&](double dm) -> bool {
+    Eigen::SparseMatrix<double> Hd = H;  // H + delta D
+    auto attempt = [&](double rel) -> bool {
         out = base;
-        // One factorization of H + delta I; grow delta if round-off makes the (PSD, singular) H fail to factor.
+        // One factorization of H + delta D; grow delta if round-off makes the (PSD, singular) H fail to factor.
         t0 = Clock::now();
         if (!llt.analyzed()) llt.analyze(H);  // a shared wrapper of another pattern is re-analyzed by factorize()
         inf.seconds_factorization += since(t0);
         bool factored = false;
-        double delta = opt.delta_rel * dm;
+        double delta = rel;
         for (int k = 0; k < 8 && !factored; ++k, delta *= 100) {
             t0 = Clock::now();
-            factored = llt.factorize(H, delta);
+            for (int j = 0; j < n; ++j) Hd.coeffRef(j, j) = H.coeff(j, j) + delta * diag[j];
+            factored = llt.factorize(Hd, 0.0);
             inf.seconds_one_factorization = since(t0);
             inf.seconds_factorization += inf.seconds_one_factorization;
             ++inf.factorizations;
@@ -386,7 +412,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
             inf.shift_grown = inf.shift_grown || (factored && k > 0);  // in either attempt
         }
         if (!factored) {
-            inf.message = "H + delta I is not positive definite up to delta = 1e2 diag scale of H: not a stable equilibrium";
+            inf.message = "H + delta |diag H| is not positive definite up to delta = 1e2: not a stable equilibrium";
             return false;
         }
 
@@ -402,7 +428,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
         }
         const CgScales sc{scale_ref, rz0, comoving_size, n};
         const std::vector<ModeCG> cg = pcg_modes(Hs, llt, B, Z0, U, sc, opt);
-        const std::vector<double> drift = true_residual_correction(Hs, llt, B, U);
+        const std::vector<ResidualError> drift = true_residual_error(Hs, H, llt, B, U, Vround);
         std::vector<char> broke(M);
         for (int m = 0; m < M; ++m) {
             const ModeCG& r = cg[m];
@@ -414,10 +440,11 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
             Mo.correction = r.c;
             Mo.value = modes[m].scale * (Mo.E_tt - r.c);
             // What the CG says is left (its tail, floored at the cancellation's round-off), and at least what the true
-            // residual says: the CG's own residual drifts from B - H U by round-off in H's stiff modes, and then its
-            // tail is no bound (a seed-scheme G of -1.13e-6 reported +- 4e-10 on AVX2 kernels, +- 3.7e-8 and
-            // -4.3e-7 on AVX-512 ones at the same state; docs/moduli.md "Error estimates").
-            Mo.error = modes[m].scale * std::max(cg_error(r, sc, m), std::abs(drift[m]));
+            // residual says, within the rounding of that residual: the CG's own residual drifts from B - H U by
+            // round-off in H's stiff modes, and then its tail is no bound (a seed-scheme G of -1.13e-6 reported
+            // +- 4e-10 on AVX2 kernels, +- 3.7e-8 and -4.3e-7 on AVX-512 ones at the same state; docs/moduli.md
+            // "Error estimates").
+            Mo.error = modes[m].scale * std::max(cg_error(r, sc, m), std::abs(drift[m].drift) + drift[m].roundoff);
             // Accepted when converged, or stopped by round-off with the tail below 1e-7 of the cancellation scale
             // (the seed scheme's 1e-4 segments at L = 20 end there; the error is reported).
             Mo.ok = std::isfinite(Mo.value) && !r.broke && (r.conv || cg_tail(r) <= 1e-7 * scale_ref[m]);
@@ -432,18 +459,18 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
     // stalled in the null space of a floppy part can understate its error: measured a G 4.6e-5 off with a bound of
     // 4e-7, tests/mechanics/moduli_test.cpp "[prune]"): the larger shift leaves fewer modes for the CG.
     inf.seconds_solve += seconds_setup;
-    const bool first = attempt(median_scale);
+    const bool first = attempt(opt.delta_rel);
     bool stalled = false;
     for (const auto& m : out) stalled = stalled || m.stalled;
     if (!first || stalled) {
         const std::vector<Modulus> kept = out;
         const std::string kept_message = inf.message;
         inf.message.clear();
-        if (!attempt(std::max(mean_scale, 100 * median_scale)) && first) {
+        if (!attempt(100 * opt.delta_rel) && first) {
             out = kept, inf.message = kept_message;
         } else if (first) {
             // Both attempts stopped somewhere: their difference is a measured lower bound on the error (a stalled
-            // CG's own bound can be 100x too small, docs/moduli.md "Why the median").
+            // CG's own bound can be 100x too small, docs/moduli.md "Error estimates").
             for (size_t m = 0; m < out.size(); ++m) out[m].error = std::max(out[m].error, std::abs(out[m].value - kept[m].value));
         }
     }

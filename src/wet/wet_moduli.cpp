@@ -15,8 +15,9 @@ std::vector<Modulus> wet_linear_moduli(WetEnergy& W, const Eigen::VectorXd& q, c
     std::vector<StrainTerms> terms(modes.size());
     for (size_t m = 0; m < modes.size(); ++m) {
         EnergyEval ev;
-        W.strain_derivatives(q, modes[m].dF, ev);
-        terms[m] = {ev.d2E_dt2, std::move(ev.d2E_dqdt), affine_velocity(dry, x, modes[m].dF * Finv)};
+        W.strain_derivatives(q, modes[m].dF, ev, true);  // comoving, per element (StrainTerms::comoving)
+        terms[m] = {ev.d2E_dt2, std::move(ev.d2E_dqdt), affine_velocity(dry, x, modes[m].dF * Finv), true,
+                    ev.d2E_dt2_size};
     }
     std::vector<Modulus> out = relaxed_moduli(H, terms, modes, opt, info);
     for (Modulus& mo : out) mo.affine = std::numeric_limits<double>::quiet_NaN();

@@ -29,7 +29,54 @@ Eigen::VectorXd perturbed(const NetworkEnergy& e, double amp, std::uint64_t seed
     return q;
 }
 
-// Checks gradient, Hessian and the three strain derivatives of E(q, F + t dF) against central differences.
+// The comoving strain derivatives (kComoving): along the affine path of every node, positions (I + t V) x with
+// V = dF F^-1 and F + t dF, they are the same algebra as the fixed-q ones with v = V x: E_tt + 2 v.b + v.H v and
+// b + H v (to the rounding of those sums), and central differences of E, of dE/dt and of the gradient along that
+// path (NetworkEnergy::affine_map). ev, Hfull: the fixed-q evaluation at (q, F) with its dense Hessian.
+void check_comoving(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
+                    const Eigen::Matrix2d& dF, const EnergyEval& ev, const Eigen::MatrixXd& Hfull) {
+    EnergyEval c;
+    e.evaluate(q, F, dF, kStrain | kComoving, c);
+    const Eigen::Matrix2d V = dF * F.inverse();
+    const Eigen::VectorXd x = e.positions(q, F);
+    Eigen::VectorXd v(e.num_dofs());
+    for (int i = 0; i < e.model().num_nodes(); ++i)
+        if (e.dof(i, 0) >= 0) v.segment<2>(e.dof(i, 0)) = V * x.segment<2>(2 * i);
+    const Eigen::VectorXd Hv = Hfull * v;
+    const double Ett = ev.d2E_dt2 + 2 * v.dot(ev.d2E_dqdt) + v.dot(Hv);
+    const double size = std::abs(ev.d2E_dt2) + 2 * v.cwiseProduct(ev.d2E_dqdt).cwiseAbs().sum() +
+                        v.cwiseProduct(Hv).cwiseAbs().sum();
+    INFO("comoving E_tt " << c.d2E_dt2 << " vs E_tt + 2 v.b + v.H v " << Ett << " (terms of size " << size << ")");
+    CHECK(std::abs(c.d2E_dt2 - Ett) <= 1e-12 * size);
+    CHECK(c.d2E_dt2_size >= std::abs(c.d2E_dt2));
+    CHECK(fdtest::rel_err(c.d2E_dqdt, Eigen::VectorXd(ev.d2E_dqdt + Hv), 1e-8) < 1e-9);
+    auto along = [&](double t, unsigned want) {
+        EnergyEval r;
+        const Eigen::Matrix2d Ft = F + t * dF;
+        e.evaluate(e.affine_map(q, F, Ft), Ft, dF, want, r);
+        return r;
+    };
+    auto richardson = [](auto d) -> decltype(d(1.0)) { return (4 * d(0.5) - d(1.0)) / 3; };
+    // A larger step than at fixed q: along this path every edge scales by (I + t V), so a step changes no element
+    // by more than ht relative, while positions of size L round to eps L, which on a segment compressed to 1e-3 of
+    // its length is 7e-12 relative (3.6e-6 in the gradient's difference at ht = 1e-6).
+    const double ht = 1e-4;
+    const double Et_fd = richardson([&](double s) {
+        return (along(s * ht, kValue).energy - along(-s * ht, kValue).energy) / (2 * s * ht);
+    });
+    const double Ett_fd = richardson([&](double s) {
+        return (along(s * ht, kStrain | kComoving).dE_dt - along(-s * ht, kStrain | kComoving).dE_dt) / (2 * s * ht);
+    });
+    const Eigen::VectorXd B_fd = richardson([&](double s) {
+        return Eigen::VectorXd((along(s * ht, kGradient).gradient - along(-s * ht, kGradient).gradient) / (2 * s * ht));
+    });
+    CHECK(c.dE_dt == Approx(Et_fd).epsilon(1e-6).margin(1e-8 * std::abs(c.d2E_dt2)));
+    CHECK(c.d2E_dt2 == Approx(Ett_fd).epsilon(1e-6));
+    CHECK(fdtest::rel_err(c.d2E_dqdt, B_fd) < 1e-6);
+}
+
+// Checks gradient, Hessian and the three strain derivatives of E(q, F + t dF) against central differences, and the
+// comoving ones (check_comoving).
 void check_all_derivatives(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
                            const Eigen::Matrix2d& dF) {
     EnergyEval ev;
@@ -73,6 +120,7 @@ void check_all_derivatives(const NetworkEnergy& e, const Eigen::VectorXd& q, con
     CHECK(ev.dE_dt == Approx(Et_fd).epsilon(1e-6).margin(1e-8 * std::abs(ev.d2E_dt2)));
     CHECK(ev.d2E_dt2 == Approx(Ett_fd).epsilon(1e-6));
     CHECK(fdtest::rel_err(ev.d2E_dqdt, Ext_fd) < 1e-6);
+    check_comoving(e, q, F, dF, ev, Hfull);
 }
 }  // namespace
 

@@ -98,25 +98,21 @@ TEST_CASE("cli modulus: a solver that does not converge exits 1 and prints no mo
     CHECK(j["stress"].is_null());
 }
 
-TEST_CASE("cli modulus: a failed linear solve on the seed scheme says so and names the way out", "[cli][modulus]") {
-    // docs/moduli.md, the limit: at L = 40 the seed scheme's 1e-6 segments leave the CG for G on round-off.
-    REQUIRE(run("modulus --L 40 --prune dangling ends -q") == 1);
-    const auto j = out();
-    CHECK(j["status"] == "modulus_failed");
-    // Which of the ill-conditioned solves (G, K) fails is round-off: the message must name exactly the ones that did.
-    const std::string err = slurp(dir() + "/stderr");
-    const std::string key = "did not converge for ";
-    const auto at = err.find(key);
-    REQUIRE(at != std::string::npos);
-    const std::string named = err.substr(at + key.size(), err.find(';', at) - at - key.size());
-    std::set<std::string> listed, failed;
-    std::istringstream ns(named);
-    for (std::string w; std::getline(ns, w, ',');) listed.insert(w.substr(w.find_first_not_of(' ')));
-    for (const char* m : {"G", "K"})
-        if (j["moduli"][m].is_null()) failed.insert(m);
-    CHECK(!failed.empty());
-    CHECK(listed == failed);
-    CHECK(err.find("--scheme even avoids them") != std::string::npos);
+TEST_CASE("cli modulus: the seed scheme's moduli on a large network agree with the even scheme's", "[cli][modulus]") {
+    // The seed scheme's segments down to 1e-6 made H + delta I unfactorable at its first shift; at the grown shift
+    // the CG stalled (L = 40: modulus_failed). With the shift relative to each coordinate's diagonal and comoving
+    // strain derivatives it converges; the two discretizations of the same network differ by 0.3 % in G at L = 20.
+    REQUIRE(run("modulus --L 20 --prune dangling ends -q") == 0);
+    const auto seed = out();
+    REQUIRE(run("modulus --L 20 --prune dangling ends --scheme even -q") == 0);
+    const auto even = out();
+    for (const char* m : {"G", "K"}) {
+        const double s = seed["moduli"][m].get<double>(), e = even["moduli"][m].get<double>();
+        INFO(m << ": seed " << s << " +- " << seed["moduli"][std::string(m) + "_error"] << ", even " << e);
+        CHECK(seed["moduli"][std::string(m) + "_error"].get<double>() <= 1e-4 * s);
+        CHECK(std::abs(s - e) <= 0.01 * e);
+    }
+    CHECK(!seed["linear_solve"]["shift_grown"].get<bool>());
 }
 
 TEST_CASE("cli modulus: an ill-conditioned seed-scheme H is reported where its errors may be understated",

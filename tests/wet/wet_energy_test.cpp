@@ -95,6 +95,29 @@ void check_derivatives(const Model& m, const Eigen::Matrix2d& F, double amp, std
         CHECK(std::abs(w.d2E_dt2 - Ett_fd) <= 1e-5 * (1e-3 + std::abs(Ett_fd)));
         CHECK(fdtest::rel_err(w.d2E_dqdt - d.d2E_dqdt, b_fd - b0_fd, 1e-3) < 1e-5);
         CHECK(fdtest::rel_err(w.d2E_dqdt, b_fd) < 1e-6);
+        // Comoving (every node on the affine path, for the wet moduli): the same algebra with v = dF F^-1 x,
+        // E_tt + 2 v.b + v.H v and b + H v, the bridges' part alone too (its terms' rounding is far below 1e-10).
+        const Eigen::Matrix2d V = dF * F.inverse();
+        const Eigen::VectorXd x = dry.positions(q, F);
+        Eigen::VectorXd v(dry.num_dofs());
+        for (int i = 0; i < m.num_nodes(); ++i)
+            if (dry.dof(i, 0) >= 0) v.segment<2>(dry.dof(i, 0)) = V * x.segment<2>(2 * i);
+        for (const bool whole : {true, false}) {
+            EnergyEval cw, cd;
+            W.strain_derivatives(q, dF, cw, true);
+            D.strain_derivatives(q, dF, cd, true);
+            const Eigen::MatrixXd& Hm = whole ? Hf : Hcap;
+            const double Ett = whole ? w.d2E_dt2 + 2 * v.dot(w.d2E_dqdt) + v.dot(Hm * v)
+                                     : (w.d2E_dt2 - d.d2E_dt2) + 2 * v.dot(w.d2E_dqdt - d.d2E_dqdt) + v.dot(Hm * v);
+            const double got = whole ? cw.d2E_dt2 : cw.d2E_dt2 - cd.d2E_dt2;
+            const Eigen::VectorXd Bv = whole ? Eigen::VectorXd(w.d2E_dqdt + Hm * v)
+                                             : Eigen::VectorXd(w.d2E_dqdt - d.d2E_dqdt + Hm * v);
+            const Eigen::VectorXd Bgot = whole ? cw.d2E_dqdt : Eigen::VectorXd(cw.d2E_dqdt - cd.d2E_dqdt);
+            INFO((whole ? "whole" : "bridges") << ": comoving E_tt " << got << " vs " << Ett);
+            CHECK(std::abs(got - Ett) <= 1e-9 * (1 + std::abs(Ett)));
+            CHECK(fdtest::rel_err(Bgot, Bv, 1e-6) < 1e-8);
+            if (strained && !whole) CHECK(std::abs(got) > 1e-4);
+        }
         if (strained) {
             CHECK(std::abs(w.dE_dt - d.dE_dt) > 1e-4);
             CHECK(std::abs(w.d2E_dt2 - d.d2E_dt2) > 1e-4);

@@ -29,6 +29,12 @@ enum Want : unsigned {
     kHessian = 2,
     kStrain = 4,       // dE/dt, d2E/dq dt, d2E/dt2 along dF
     kProjectPSD = 8,   // project each element's Hessian to PSD (Hessian only; strain derivatives stay exact)
+    // With kStrain: the strain derivatives along the affine path of all nodes, x(t) = (I + t dF F^-1) x (comoving
+    // coordinates, docs/moduli.md) instead of at fixed q: per element dd/dt = dF F^-1 d, so that
+    //   d2E_dt2 = E_tt + 2 v.E_xt + v.H v,  d2E_dqdt = E_xt + H v  (v = dF F^-1 x of the free nodes)
+    // come from the elements' own edge vectors, without the cancellation of the large |v| (up to L) that the sums
+    // on the right carry through H's stiff entries.
+    kComoving = 16,
 };
 
 struct EnergyEval {
@@ -37,6 +43,7 @@ struct EnergyEval {
     double dE_dt = 0;                // strain derivatives along dF
     Eigen::VectorXd d2E_dqdt;
     double d2E_dt2 = 0;
+    double d2E_dt2_size = 0;         // sum of the elements' |terms| of d2E_dt2 (the scale of its rounding)
 };
 
 class NetworkEnergy {

@@ -5,12 +5,12 @@
 //   d2E/dt2 (relaxed) = E_tt - E_xt^T H^+ E_xt,    H = E_xx, E_xt = d2E/dx dt, E_tt = d2E/dt2 at fixed x,
 // and a modulus is scale * that. E_xt lies in range(H) at an equilibrium (differentiate g(q*(t), t) = 0), so
 // H's null space (translations, floppy clusters) does not contribute. H^+ E_xt is computed with ONE
-// factorization of H + delta I (delta = 1e-12 median |diag H|, grown on failure), used as the preconditioner of
-// conjugate gradients on H u = E_xt: the preconditioned spectrum lambda / (lambda + delta) is 1 except for the few
-// modes with lambda ~ delta, so CG converges in a handful of steps, each one solve and no new factorization;
-// from u_0 = 0 it never enters the null space (the residual stays in range(H)). The shift is not a bias: CG removes
-// it. `error` estimates what the solve and the state leave (docs/moduli.md "Error estimates"): the CG's tail, what
-// its true residual shows, and the change one Newton step away from q.
+// factorization of H + delta D (D = |diag H|, delta = 1e-12, grown on failure), used as the preconditioner of
+// conjugate gradients on H u = E_xt: the preconditioned spectrum lambda / (lambda + delta) (lambda: eigenvalues of
+// D^-1/2 H D^-1/2) is 1 except for the few modes with lambda ~ delta, so CG converges in a handful of steps, each one
+// solve and no new factorization; from u_0 = 0 it never enters the null space (the residual stays in range(H)). The
+// shift is not a bias: CG removes it. `error` estimates what the solve and the state leave (docs/moduli.md "Error
+// estimates"): the CG's tail, what its true residual shows within its rounding, and the change one Newton step away.
 //
 // Normalisations (2D, current box area A):
 //   shear  G: dF = e_x e_y^T F (simple shear of the current state), G = (1/A) d2E/dt2;
@@ -48,11 +48,11 @@ struct Modulus {
     int refinements = 0;        // conjugate-gradient steps
     bool stalled = false;       // round-off stopped the conjugate gradients before they converged
     Eigen::VectorXd response;   // a solution of H r = E_xt: dq/dt = -response along the mode
-    bool ok = false;        // false: H + delta I could not be factored or the refinement did not converge
+    bool ok = false;        // false: H + delta D could not be factored or the refinement did not converge
 };
 
 struct ModuliOptions {
-    double delta_rel = 1e-12;   // initial shift relative to median |diag H| (x100 while the factorization fails)
+    double delta_rel = 1e-12;   // initial shift delta of H + delta |diag H| (x100 while the factorization fails)
     int max_refinements = 200;  // conjugate-gradient steps
     double refine_tol = 1e-13;  // stop when a CG increment of E_xt.u is below this fraction of max(E_tt, b.M b)
     // linear_moduli: q must be an equilibrium, max|g| <= max(equilibrium_tol, the round-off floor of the coordinates
@@ -65,8 +65,8 @@ struct ModuliOptions {
 };
 
 struct ModuliInfo {
-    double delta = 0;          // shift of the factorization used
-    // H + delta I failed to factor at the first shift (round-off made pivots negative): H is ill-conditioned at
+    double delta = 0;          // shift delta of the factorization of H + delta |diag H| used
+    // H + delta D failed to factor at the first shift (round-off made pivots negative): H is ill-conditioned at
     // round-off, the CG resolves its soft modes poorly, and the errors may be understated (docs/moduli.md).
     bool shift_grown = false;
     double grad_max = 0, grad_floor = 0;  // linear_moduli: max|g| at q and its round-off floor
@@ -81,13 +81,18 @@ struct ModuliInfo {
 
 // The relaxed part on its own, for any energy that provides its Hessian H (upper triangle, at an equilibrium) and,
 // per mode, the fixed-coordinate strain derivatives: value = scale * (E_tt - b.H^+ b), computed in comoving
-// coordinates (v: the affine velocity dF F^-1 x of the free coordinates, affine_velocity) as above. linear_moduli
+// coordinates (v: the affine velocity dF F^-1 x of the free coordinates, affine_velocity) as above, or the
+// comoving ones themselves (StrainTerms::comoving: the dry energy's, summed per element without cancellation). linear_moduli
 // is this plus the dry energy's derivatives and the affine prediction; the wet energy's linear moduli use it with the
 // bridges' terms (wet/wet_moduli.hpp). Modulus::affine is left 0.
 struct StrainTerms {
     double E_tt = 0;    // d2E/dt2 at fixed q
     Eigen::VectorXd b;  // d2E/dq dt at fixed q
     Eigen::VectorXd v;  // affine velocity of the free coordinates
+    // E_tt and b are already the comoving E_tt + 2 v.b + v.H v and b + H v, summed per element (kComoving,
+    // network_energy.hpp); E_tt_size: the sum of its terms' magnitudes.
+    bool comoving = false;
+    double E_tt_size = 0;
 };
 class CholmodLLT;
 std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const std::vector<StrainTerms>& terms,

@@ -49,7 +49,11 @@ public:
     // (X_a = x_a + F B0 n_a, x_a = F x_ref for a fixed node: linear in F), so dX_a/dt = w_a = dF r_a with r_a = B0 n_a
     // (+ x_ref for a fixed node), d2X/dt2 = 0, and its terms are g.w, H w and w.H w.
     // For the wet linear moduli (wet_moduli.hpp).
-    void strain_derivatives(const Eigen::VectorXd& q, const Eigen::Matrix2d& dF, EnergyEval& out) const;
+    // comoving: along the affine path of every node instead (kComoving, network_energy.hpp): w_a = dF F^-1 (X_a -
+    // X_0), X_0 the element's first node (each element is translation invariant, so the reference point drops out of
+    // g.w and H w and only the element's own extent enters, without the cancellation of the large |v|).
+    void strain_derivatives(const Eigen::VectorXd& q, const Eigen::Matrix2d& dF, EnergyEval& out,
+                            bool comoving = false) const;
 
     const NetworkEnergy& dry() const { return dry_; }
     const Eigen::Matrix2d& F() const { return F_; }
