@@ -328,6 +328,39 @@ std::string failure_message(const std::vector<Modulus>& out, const std::vector<c
         msg += (msg.empty() ? "" : "; ") + std::string("conjugate gradients for H^+ E_xt did not converge for ") + unconverged;
     return msg;
 }
+// The comoving right-hand sides B and E_tt (written into out[m].E_tt) of relaxed_moduli. With v = dF F^{-1} x the
+// affine velocity of the free nodes,
+//   E_tt - b.H^+ b = (E_tt + 2 v.b + v.H v) - (b + H v).H^+ (b + H v)     (b in range(H)),
+// whose two terms are the affine and non-affine parts: O(G A) instead of O(L^2 k) with absolute coordinates, where
+// box-crossing segments make E_tt ~ 1e8 and the cancellation costs 6 digits. Terms already comoving (formed per
+// element, StrainTerms::comoving) are taken as they are.
+struct ComovingRhs {
+    Eigen::MatrixXd B, V;
+    Eigen::MatrixXd Vround;     // v where B and E_tt were formed through H v (their rounding), else 0
+    std::vector<double> size;   // sum of |terms| of the comoving E_tt (its round-off's scale)
+};
+ComovingRhs comoving_rhs(const Eigen::SparseMatrix<double>& H, const std::vector<StrainTerms>& terms,
+                         std::vector<Modulus>& out) {
+    const auto Hs = H.selfadjointView<Eigen::Upper>();
+    const int n = static_cast<int>(H.rows()), M = static_cast<int>(terms.size());
+    ComovingRhs r{Eigen::MatrixXd(n, M), Eigen::MatrixXd(n, M), Eigen::MatrixXd::Zero(n, M), std::vector<double>(M)};
+    for (int m = 0; m < M; ++m) {
+        const Eigen::VectorXd& v = terms[m].v;
+        r.V.col(m) = v;
+        if (terms[m].comoving) {
+            r.size[m] = std::max(terms[m].E_tt_size, std::abs(out[m].E_tt));
+            r.B.col(m) = terms[m].b;
+            continue;
+        }
+        const Eigen::VectorXd Hv = Hs * v;
+        r.size[m] = std::abs(out[m].E_tt) + 2 * v.cwiseProduct(terms[m].b).cwiseAbs().sum() +
+                    v.cwiseProduct(Hv).cwiseAbs().sum();
+        out[m].E_tt += 2 * v.dot(terms[m].b) + v.dot(Hv);
+        r.B.col(m) = terms[m].b + Hv;
+        r.Vround.col(m) = v;
+    }
+    return r;
+}
 }  // namespace
 
 std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const std::vector<StrainTerms>& terms,
@@ -366,28 +399,9 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
     auto t0 = Clock::now();
     const auto Hs = H.selfadjointView<Eigen::Upper>();
     const int M = static_cast<int>(modes.size());
-    Eigen::MatrixXd B(n, M), V(n, M);
-    Eigen::MatrixXd Vround = Eigen::MatrixXd::Zero(n, M);  // v where B and E_tt were formed through H v (rounding)
-    std::vector<double> comoving_size(M);
-    for (int m = 0; m < M; ++m) {
-        // Comoving (affine) coordinates: with v = dF F^{-1} x the affine velocity of the free nodes,
-        //   E_tt - b.H^+ b = (E_tt + 2 v.b + v.H v) - (b + H v).H^+ (b + H v)     (b in range(H)),
-        // whose two terms are the affine and non-affine parts: O(G A) instead of O(L^2 k) with absolute
-        // coordinates, where box-crossing segments make E_tt ~ 1e8 and the cancellation costs 6 digits.
-        const Eigen::VectorXd& v = terms[m].v;
-        V.col(m) = v;
-        if (terms[m].comoving) {  // formed per element already
-            comoving_size[m] = std::max(terms[m].E_tt_size, std::abs(out[m].E_tt));
-            B.col(m) = terms[m].b;
-            continue;
-        }
-        const Eigen::VectorXd Hv = Hs * v;
-        comoving_size[m] = std::abs(out[m].E_tt) + 2 * v.cwiseProduct(terms[m].b).cwiseAbs().sum() +
-                           v.cwiseProduct(Hv).cwiseAbs().sum();  // what the comoving E_tt's sum cancels
-        out[m].E_tt += 2 * v.dot(terms[m].b) + v.dot(Hv);
-        B.col(m) = terms[m].b + Hv;
-        Vround.col(m) = v;
-    }
+    const ComovingRhs rhs = comoving_rhs(H, terms, out);
+    const Eigen::MatrixXd &B = rhs.B, &V = rhs.V, &Vround = rhs.Vround;
+    const std::vector<double>& comoving_size = rhs.size;
     const double seconds_setup = since(t0);
     const std::vector<Modulus> base = out;
     CholmodLLT own;
