@@ -1,6 +1,5 @@
 #include "fibernet/mechanics/moduli.hpp"
 
-#include <numeric>
 #include <chrono>
 #include <cmath>
 #include <algorithm>
