@@ -8,7 +8,8 @@
 #   bench/run_sweep_cost.sh                       # L = 5 10 15 20, unpruned and --prune dangling ends
 #   LS="5 10" PRUNES="none" bench/run_sweep_cost.sh
 # Environment: FIBERNET (executable, default build/fibernet), OUT (default docs/sweep), LS, PRUNES ("none" and/or
-# "dangling,ends"), GAMMA_MAX (0.05), STEP (0.01), MIN_STEP (1e-3), TIME_LIMIT (seconds per sweep, 600).
+# "dangling,ends"), GAMMA_MAX (0.05), STEP (0.01), MIN_STEP (1e-3), TIME_LIMIT (seconds per sweep, 600),
+# SOLVER_FLAGS (extra flags for every sweep, e.g. "--eliminate"; docs/solvers.md "Nonlinear elimination").
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 exe=${FIBERNET:-$root/build/fibernet}
@@ -45,7 +46,7 @@ for L in $Ls; do
         # the rows written so far; the status column says which.
         rc=0
         res=$(timeout -k 60 "$limit" "$exe" sweep "${net[@]}" --gamma-max "$gamma_max" --step "$step" \
-            --min-step "$min_step" -q -o "$rows") || rc=$?
+            --min-step "$min_step" ${SOLVER_FLAGS:-} -q -o "$rows") || rc=$?
         [ "$rc" = 0 ] || echo "L = $L, prune $prune: exit $rc: $res" >&2
         t1=$(date +%s.%N)
         load1=$(cut -d' ' -f1 /proc/loadavg)

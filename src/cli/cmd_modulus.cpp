@@ -21,6 +21,9 @@ nlohmann::json solve_json(const SolveResult& r, double tol) {
             {"iterations", r.iterations},
             {"factorizations", r.factorizations},
             {"evaluations", r.evaluations},
+            {"local_solves", r.local_solves},
+            {"local_iterations", r.local_iterations},
+            {"local_factorizations", r.local_factorizations},
             {"grad_max", r.grad_max},
             {"grad_floor_bound", r.grad_floor},
             {"tol", tol},
@@ -58,7 +61,7 @@ void register_modulus(CLI::App& app) {
         const auto t_all = std::chrono::steady_clock::now();
         Scene s = flags->resolve();
         SolverOptions so;
-        so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.verbose = *verbose;
+        so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.eliminate = s.solver.eliminate, so.verbose = *verbose;
         auto solver = make_solver(s.solver.name, so);  // unknown name: InputError before any work
 
         auto t0 = std::chrono::steady_clock::now();

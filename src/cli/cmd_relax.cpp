@@ -35,7 +35,7 @@ void register_relax(CLI::App& app) {
         Scene s = flags->resolve();
         check_outputs({{"--output", *out}});  // before the solve, not after it
         SolverOptions so;
-        so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.verbose = *verbose;
+        so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.eliminate = s.solver.eliminate, so.verbose = *verbose;
         auto solver = make_solver(s.solver.name, so);
         Network net = scene_network(s);
         Model m = discretize(net, s.discretization);

@@ -289,7 +289,7 @@ void register_sweep(CLI::App& app) {
         Checkpoint c;
         if (*resume) c = read_checkpoint(*ckpt, params, *p);  // before any work: a mismatch costs nothing
         SolverOptions so;
-        so.tol = s.solver.tol, so.max_iter = s.solver.max_iter;
+        so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.eliminate = s.solver.eliminate;
         auto solver = make_solver(s.solver.name, so);
         SolverOptions so_snap = so;  // the snap-through budget at the smallest step (docs/sweep.md)
         so_snap.max_iter = 10 * so.max_iter;

@@ -1,4 +1,5 @@
 #include "fibernet/energy/network_energy.hpp"
+#include "fibernet/energy/network_region.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -308,6 +309,11 @@ void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
         }
     }
     out.energy = out.stretch + out.bend;
+}
+
+std::unique_ptr<Objective> StrainedEnergy::restriction(const Eigen::VectorXd& q, const std::vector<int>& coords) {
+    if (!incidence_) incidence_ = std::make_shared<const NodeElements>(node_elements(e_));
+    return std::make_unique<NetworkRegion>(e_, F_, *incidence_, q, coords);
 }
 
 double StrainedEnergy::value(const Eigen::VectorXd& q) {

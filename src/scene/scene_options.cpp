@@ -100,6 +100,9 @@ std::vector<SceneOption> declare() {
     add(text("solver", "name", "--solver", "solver", [](Scene& s) -> std::string& { return s.solver.name; }));
     add(real("solver", "tol", "--tol", "max |gradient| to stop at", [](Scene& s) -> double& { return s.solver.tol; }));
     add(integer("solver", "max_iter", "--max-iter", "iteration limit", [](Scene& s) -> int& { return s.solver.max_iter; }));
+    add(boolean("solver", "eliminate", "--eliminate",
+                "Newton: solve the hot places to local equilibrium before and inside each global step (docs/solvers.md)",
+                [](Scene& s) -> bool& { return s.solver.eliminate; }));
     // [wet] (docs/wet.md)
     add(real("wet", "beta", "--beta", "adhesion per unit bundle length, bending units",
              [](Scene& s) -> double& { return s.wet.beta; }));

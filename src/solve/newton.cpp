@@ -97,6 +97,8 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         r.timings.factorization += since(t0);
     }
     CholmodLDL* ldl = opt_.ldl ? ldl_.get() : nullptr;
+    std::unique_ptr<NonlinearElimination> ne;
+    if (opt_.eliminate && n > 0) ne = std::make_unique<NonlinearElimination>(H, opt_.elimination);
 
     Eigen::VectorXd g(n), gt(n), d(n), qt(n);
     int start_rung = 0;
@@ -119,7 +121,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
             r.grad_max = n > 0 ? g.lpNorm<Eigen::Infinity>() : 0.0;
             break;
         }
-        const double gmax = n > 0 ? g.lpNorm<Eigen::Infinity>() : 0.0;
+        double gmax = n > 0 ? g.lpNorm<Eigen::Infinity>() : 0.0;
         r.grad_max = gmax;
         history_.push_back(gmax);
         if (gmax <= opt_.tol) {
@@ -159,6 +161,32 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
             r.status = SolveStatus::IterationLimit;
             r.message = "time limit reached";
             break;
+        }
+
+        // Nonlinear elimination (nonlinear_elimination.hpp): the hot places to local equilibrium, then H and g again.
+        double local_tol = 0;
+        bool eliminating = false;
+        if (ne && ne->select(g)) {
+            local_tol = std::max(opt_.tol, opt_.elimination.local_rtol * gmax);
+            ne->eliminate(f, q, local_tol);
+            eliminating = true;
+            auto ta = Clock::now();
+            fq = f.hessian(q, g, H, projected);
+            r.timings.assembly += since(ta);
+            ++r.evaluations;
+            r.energy = fq;
+            r.grad_max = gmax = n > 0 ? g.lpNorm<Eigen::Infinity>() : 0.0;
+            if (!std::isfinite(fq) || !g.allFinite()) {
+                r.status = SolveStatus::NonFinite;
+                r.message = "non-finite energy or gradient after the elimination of iteration " + std::to_string(it);
+                break;
+            }
+            if (r.grad_max <= opt_.tol) {
+                history_.back() = r.grad_max;
+                r.status = SolveStatus::Converged;
+                r.message = "max|g| <= tol";
+                break;
+            }
         }
 
         // The ladder: find a descent direction.
@@ -255,6 +283,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
                 alpha = 1;
                 for (int k = 0; k < kMaxHalvings; ++k, alpha *= 0.5) {
                     qt = q + alpha * d;
+                    if (eliminating) ne->eliminate(f, qt, local_tol);  // the places back in their valleys
                     ft = f.value(qt);
                     ++r.evaluations;
                     if (!std::isfinite(ft)) continue;
@@ -312,11 +341,17 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
     // The floor at the returned state: H was assembled there (every exit follows an assembly at q; a failed line
     // search leaves q where H was assembled, possibly as the projected Hessian of the ladder's lower rungs).
     if (n > 0 && r.status != SolveStatus::NonFinite) r.grad_floor = roundoff_floor(H, q);
+    if (ne) {
+        const EliminationCounts& c = ne->counts();
+        r.local_solves = c.local_solves, r.local_iterations = c.local_iterations;
+        r.local_factorizations = c.local_factorizations;
+    }
     r.timings.total = since(t_start);
     if (mu_lm > 0 && dm_last > 0) shift_rel_ = mu_lm / dm_last;
     if (opt_.verbose)
-        std::fprintf(stderr, "newton: %s after %d iterations, %d factorizations, max|g| = %.3e, %.3f s\n",
-                     to_string(r.status).c_str(), r.iterations, r.factorizations, r.grad_max, r.timings.total);
+        std::fprintf(stderr, "newton: %s after %d iterations, %d factorizations (%d local solves, %d local iterations), "
+                     "max|g| = %.3e, %.3f s\n", to_string(r.status).c_str(), r.iterations, r.factorizations,
+                     r.local_solves, r.local_iterations, r.grad_max, r.timings.total);
     return r;
 }
 

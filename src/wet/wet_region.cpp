@@ -1,5 +1,7 @@
 #include "fibernet/wet/wet_region.hpp"
 
+#include "fibernet/energy/network_region.hpp"
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -29,15 +31,6 @@ void build_rows(int nn, int ne, NodesOf nodes_of, std::vector<int>& start, std::
     }
 }
 
-// The elements of one kind (compressed rows start/list) at the given nodes, each once, in index order: the order in
-// which the whole energy sums them.
-std::vector<int> elements_at(const std::vector<int>& start, const std::vector<int>& list, const std::vector<int>& nodes) {
-    std::vector<int> out;
-    for (int v : nodes) out.insert(out.end(), list.begin() + start[v], list.begin() + start[v + 1]);
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
-}
 }  // namespace
 
 ElementIncidence element_incidence(const WetEnergy& W) {
@@ -218,14 +211,8 @@ double WetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::Spa
         hv = H->valuePtr();
         std::fill(hv, hv + H->nonZeros(), 0.0);
     }
-    // Adds an element's gradient and Hessian (M local coordinates) through its index and slot tables.
     auto add = [&](const int* idx, const int* slot, int M, const double* ge, const double* he) {
-        if (g)
-            for (int a = 0; a < M; ++a)
-                if (idx[a] >= 0) (*g)[idx[a]] += ge[a];
-        if (H)
-            for (int j = 0; j < M * M; ++j)
-                if (slot[j] >= 0) hv[slot[j]] += he[(j % M) * M + j / M];  // column-major element block
+        scatter_element(idx, slot, M, ge, he, g, hv);
     };
     double E = 0;
     Eigen::Vector4d g4;

@@ -18,6 +18,8 @@
 
 namespace fibernet {
 
+struct NodeElements;  // network_region.hpp
+
 struct EnergyParams {
     StretchLaw stretch;
 };
@@ -102,12 +104,15 @@ public:
     double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override;
     double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool project_psd) override;
     const Eigen::SparseMatrix<double>& hessian_pattern() const override { return e_.hessian_pattern(); }
+    // A NetworkRegion (network_region.hpp): the segments and hinges at the set's nodes only.
+    std::unique_ptr<Objective> restriction(const Eigen::VectorXd& q, const std::vector<int>& coords) override;
     const Eigen::Matrix2d& F() const { return F_; }
 
 private:
     const NetworkEnergy& e_;
     Eigen::Matrix2d F_;
     EnergyEval eval_;
+    std::shared_ptr<const NodeElements> incidence_;  // built on the first restriction()
 };
 
 }  // namespace fibernet

@@ -3,6 +3,8 @@
 // of a function of n unknowns. Nothing else of the model reaches a solver.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <memory>
+#include <vector>
 
 namespace fibernet {
 
@@ -20,6 +22,16 @@ public:
                            bool project_psd) = 0;
     // Upper-triangular CSC pattern, values zero; fixed for the lifetime of the objective.
     virtual const Eigen::SparseMatrix<double>& hessian_pattern() const = 0;
+    // Optional, for nonlinear elimination (solve/nonlinear_elimination.hpp): the energy as a function of the
+    // coordinates `coords` (sorted, distinct) alone, every other coordinate held where q has it. Its value may differ
+    // from value() by a constant (the elements that touch no coordinate of the set are left out); its gradient and
+    // Hessian are this objective's restricted to the set. Evaluated at a cost proportional to the set's elements, not
+    // the network's. nullptr: not offered (the solver then restricts through value/gradient/Hessian, SubsetObjective).
+    // The result refers to this objective and must not outlive it.
+    virtual std::unique_ptr<Objective> restriction(const Eigen::VectorXd& q, const std::vector<int>& coords) {
+        (void)q, (void)coords;
+        return nullptr;
+    }
 };
 
 }  // namespace fibernet

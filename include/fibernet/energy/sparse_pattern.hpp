@@ -1,6 +1,7 @@
 #pragma once
 // Upper-triangular CSC Hessian patterns built from elements and other patterns, and the value slots of entries: shared
 // by the energies that assemble into a fixed pattern (wet_energy.hpp, wet_region.hpp, network_energy.hpp).
+#include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <vector>
 
@@ -42,5 +43,18 @@ void element_slots(const Eigen::SparseMatrix<double>& P, const std::vector<int>&
 // The slot in P of every entry of a pattern S contained in P, in S's value order (one pass per column). Throws like
 // pattern_slot if P lacks one.
 std::vector<int> subpattern_slots(const Eigen::SparseMatrix<double>& P, const Eigen::SparseMatrix<double>& S);
+
+// Adds one element's gradient ge (M local coordinates) to g and its Hessian block he (M x M, column-major) to the
+// values hv, through the element's index table idx (-1: a held coordinate) and slot table (element_slots; -1: not
+// stored). g or hv may be null (value or gradient only).
+inline void scatter_element(const int* idx, const int* slot, int M, const double* ge, const double* he,
+                            Eigen::VectorXd* g, double* hv) {
+    if (g)
+        for (int a = 0; a < M; ++a)
+            if (idx[a] >= 0) (*g)[idx[a]] += ge[a];
+    if (hv)
+        for (int j = 0; j < M * M; ++j)
+            if (slot[j] >= 0) hv[slot[j]] += he[(j % M) * M + j / M];
+}
 
 }  // namespace fibernet

@@ -17,6 +17,7 @@ struct SolverSettings {
     std::string name = "newton";
     double tol = 1e-10;        // max |gradient| in seed units
     int max_iter = 500;
+    bool eliminate = false;    // Newton: nonlinear elimination (solve/nonlinear_elimination.hpp)
 };
 
 // [wet] (docs/formats.md, "Wet scenes"; issue 6): capillary bridges for `fibernet wet`. Plain values here; the wet

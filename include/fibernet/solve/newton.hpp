@@ -20,6 +20,9 @@
 // Line search: Armijo backtracking from alpha = 1 (halving); +inf or NaN energies are failed trials (softcore,
 // stretch.hpp). Near convergence the energy decrease falls below round-off; a full step is then accepted when
 // the energy did not rise beyond round-off and max|g| fell.
+// With SolverOptions::eliminate, each iteration first solves the hot places to local equilibrium and the line search
+// re-solves them at every trial point (nonlinear_elimination.hpp); iterations and factorizations count the global
+// ones, SolveResult::local_* the local solves.
 #include <memory>
 #include <string>
 #include <vector>

@@ -32,6 +32,9 @@ struct SolveResult {
     int factorizations = 0;
     int ldl_retries = 0;                // Newton: iterations whose LDL^T direction failed its line search (SolverOptions::ldl)
     int evaluations = 0;                // energy/gradient evaluations
+    int local_solves = 0;               // Newton with elimination: part solves, their iterations and factorizations
+    int local_iterations = 0;           // (not counted in iterations and factorizations above, which are global)
+    int local_factorizations = 0;
     double energy = 0;
     double grad_max = 0;                // max |g| at the returned state
     double grad_floor = 0;              // round-off floor of max |g| at the returned state (Newton; 0: not estimated)

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "fibernet/energy/objective.hpp"
+#include "fibernet/solve/nonlinear_elimination.hpp"
 #include "fibernet/solve/result.hpp"
 
 namespace fibernet {
@@ -18,6 +19,9 @@ struct SolverOptions {
                              // that resumes an interrupted solve of a slightly changed objective; others ignore it
     bool ldl = false;        // Newton: rung 0 by a simplicial LDL^T of the exact H + mu I with negative pivots flipped
                              // (cholmod_ldl.hpp) instead of the escalated shift; others ignore it
+    bool eliminate = false;  // Newton: nonlinear elimination of the hot places before and inside each global step
+                             // (nonlinear_elimination.hpp); others ignore it
+    EliminationOptions elimination;
 };
 
 class Solver {

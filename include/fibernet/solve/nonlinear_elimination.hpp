@@ -1,0 +1,68 @@
+#pragma once
+// Nonlinear elimination for Newton (issue 23; Cai & Keyes, SIAM J. Sci. Comput. 24, 2002; Cai & Li, SIAM J. Sci.
+// Comput. 33, 2011). Newton's global step on a Mikado network is held back by a few local places (pinned bars and small
+// linkages that must rotate: curved valleys, docs/moduli.md "Where Newton's iterations go"); a linear step can follow a
+// curved valley only a short way, so each place needs tens of global iterations, and the network's slowest place sets
+// the count. Here the places are solved to local equilibrium with the rest of the network held, at the cost of their
+// own elements:
+//   - before each global step, the coordinates with |g_i| > threshold max|g|, grown by `hops` steps through the
+//     Hessian's pattern (one step: the coordinates an element couples), split into connected parts, each minimized;
+//   - inside the global line search, the same parts are minimized again at every trial point, so the global step is
+//     judged with the places back in their valleys (the Newton step on the remaining coordinates is then the step on
+//     the reduced energy, whose Hessian is the Schur complement, because the parts' gradients vanish).
+// Every local solve only lowers the energy, so the global energy never rises; convergence is still tested on the
+// whole gradient. The solver sees only value, gradient, Hessian and the pattern; an objective that offers
+// Objective::restriction is restricted at the cost of the parts' elements, any other through SubsetObjective.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <string>
+#include <vector>
+
+#include "fibernet/energy/objective.hpp"
+
+namespace fibernet {
+
+struct EliminationOptions {
+    double threshold = 0.05;    // a coordinate is hot when |g_i| > threshold max|g|, in (0, 1)
+    int hops = 16;              // growth of the hot set through the Hessian pattern, >= 0
+    double max_fraction = 0.25; // no elimination when the grown set holds more than this share of the coordinates
+    double local_rtol = 1e-3;   // a part is solved to max|g_part| <= max(tol, local_rtol max|g|), in (0, 1)
+    int local_max_iter = 200;   // Newton iterations per part and solve, >= 1
+
+    // Throws InputError("<where>: elimination.<name> = <v> must ...").
+    void check(const std::string& where) const;
+};
+
+struct EliminationCounts {
+    int selections = 0;        // global iterations that eliminated
+    int local_solves = 0;      // part solves (before the steps and at the line searches' trial points)
+    int local_iterations = 0;  // Newton iterations of those solves
+    int local_factorizations = 0;
+    double seconds = 0;
+};
+
+class NonlinearElimination {
+public:
+    // pattern: the objective's Hessian pattern (upper triangle), from which the coupling graph is built once.
+    NonlinearElimination(const Eigen::SparseMatrix<double>& pattern, EliminationOptions opt);
+
+    // Picks the parts from the gradient g at the current state; false (no parts) when nothing is hot beyond the grown
+    // set's size limit or max|g| is zero.
+    bool select(const Eigen::VectorXd& g);
+    const std::vector<std::vector<int>>& parts() const { return parts_; }
+    int coordinates() const { return selected_; }
+
+    // Minimizes f over each part in turn, the others held, overwriting q's entries of the parts; never raises f.
+    void eliminate(Objective& f, Eigen::VectorXd& q, double tol);
+
+    const EliminationCounts& counts() const { return counts_; }
+
+private:
+    EliminationOptions opt_;
+    std::vector<int> adj_start_, adj_;  // symmetric coupling graph over the coordinates
+    std::vector<std::vector<int>> parts_;
+    int selected_ = 0;
+    EliminationCounts counts_;
+};
+
+}  // namespace fibernet

@@ -1,0 +1,101 @@
+#include "fibernet/solve/nonlinear_elimination.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+
+#include "fibernet/solve/newton.hpp"
+#include "fibernet/solve/subset_objective.hpp"
+#include "fibernet/util/error.hpp"
+
+namespace fibernet {
+
+void EliminationOptions::check(const std::string& where) const {
+    check_value(threshold > 0 && threshold < 1, threshold, where, "elimination.threshold", "must lie in (0, 1)");
+    check_value(hops >= 0, hops, where, "elimination.hops", "must be >= 0");
+    check_value(max_fraction > 0 && max_fraction <= 1, max_fraction, where, "elimination.max_fraction",
+                "must lie in (0, 1]");
+    check_value(local_rtol > 0 && local_rtol < 1, local_rtol, where, "elimination.local_rtol", "must lie in (0, 1)");
+    check_value(local_max_iter >= 1, local_max_iter, where, "elimination.local_max_iter", "must be >= 1");
+}
+
+NonlinearElimination::NonlinearElimination(const Eigen::SparseMatrix<double>& P, EliminationOptions opt) : opt_(opt) {
+    opt_.check("newton");
+    const int n = static_cast<int>(P.cols());
+    // Both triangles of the pattern, without the diagonal: coordinate i couples j when some element holds both.
+    adj_start_.assign(n + 1, 0);
+    for (int j = 0; j < n; ++j)
+        for (int p = P.outerIndexPtr()[j]; p < P.outerIndexPtr()[j + 1]; ++p)
+            if (P.innerIndexPtr()[p] != j) ++adj_start_[j + 1], ++adj_start_[P.innerIndexPtr()[p] + 1];
+    for (int i = 0; i < n; ++i) adj_start_[i + 1] += adj_start_[i];
+    adj_.resize(adj_start_[n]);
+    std::vector<int> fill(adj_start_.begin(), adj_start_.end() - 1);
+    for (int j = 0; j < n; ++j)
+        for (int p = P.outerIndexPtr()[j]; p < P.outerIndexPtr()[j + 1]; ++p) {
+            const int i = P.innerIndexPtr()[p];
+            if (i != j) adj_[fill[i]++] = j, adj_[fill[j]++] = i;
+        }
+}
+
+bool NonlinearElimination::select(const Eigen::VectorXd& g) {
+    parts_.clear();
+    selected_ = 0;
+    const int n = static_cast<int>(g.size());
+    const double gmax = n > 0 ? g.lpNorm<Eigen::Infinity>() : 0.0;
+    if (!(gmax > 0)) return false;
+    // The hot coordinates, grown breadth first `hops` times.
+    std::vector<char> in(n, 0);
+    std::vector<int> frontier, next;
+    for (int i = 0; i < n; ++i)
+        if (std::abs(g[i]) > opt_.threshold * gmax) in[i] = 1, frontier.push_back(i);
+    int count = static_cast<int>(frontier.size());
+    const int cap = static_cast<int>(opt_.max_fraction * n);
+    for (int h = 0; h < opt_.hops && !frontier.empty() && count <= cap; ++h) {
+        next.clear();
+        for (int i : frontier)
+            for (int p = adj_start_[i]; p < adj_start_[i + 1]; ++p)
+                if (!in[adj_[p]]) in[adj_[p]] = 1, next.push_back(adj_[p]), ++count;
+        frontier.swap(next);
+    }
+    if (count > cap) return false;
+    // Connected parts of the set: coordinates of distinct parts share no element, so their energies are independent
+    // with the rest held.
+    std::vector<char> seen(n, 0);
+    for (int s = 0; s < n; ++s) {
+        if (!in[s] || seen[s]) continue;
+        std::vector<int> part{s};
+        seen[s] = 1;
+        for (size_t k = 0; k < part.size(); ++k)
+            for (int p = adj_start_[part[k]]; p < adj_start_[part[k] + 1]; ++p) {
+                const int j = adj_[p];
+                if (in[j] && !seen[j]) seen[j] = 1, part.push_back(j);
+            }
+        std::sort(part.begin(), part.end());
+        parts_.push_back(std::move(part));
+    }
+    selected_ = count;
+    ++counts_.selections;
+    return true;
+}
+
+void NonlinearElimination::eliminate(Objective& f, Eigen::VectorXd& q, double tol) {
+    const auto t0 = std::chrono::steady_clock::now();
+    SolverOptions o;
+    o.tol = tol, o.max_iter = opt_.local_max_iter;
+    for (const std::vector<int>& part : parts_) {
+        std::unique_ptr<Objective> sub = f.restriction(q, part);
+        if (!sub) sub = std::make_unique<SubsetObjective>(f, q, part);
+        Eigen::VectorXd qa(part.size());
+        for (size_t k = 0; k < part.size(); ++k) qa[k] = q[part[k]];
+        NewtonSolver local(o);
+        const SolveResult r = local.minimize(*sub, qa);
+        ++counts_.local_solves;
+        counts_.local_iterations += r.iterations, counts_.local_factorizations += r.factorizations;
+        // Newton accepts only steps that lower the energy, so its last state is never worse than the start, converged
+        // or not; a non-finite start leaves qa as it was.
+        for (size_t k = 0; k < part.size(); ++k) q[part[k]] = qa[k];
+    }
+    counts_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace fibernet
