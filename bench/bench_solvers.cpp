@@ -58,7 +58,7 @@
 #include "fibernet/model/prune.hpp"
 #include "fibernet/network/mikado.hpp"
 #include "fibernet/solve/solver.hpp"
-#include "fibernet/solve/solver_suite.hpp"
+#include "fibernet/solve/solver_registry.hpp"
 #include "fibernet/wet/active_set.hpp"
 #include "fibernet/wet/wet_energy.hpp"
 #include "fibernet/wet/wetting.hpp"
@@ -185,6 +185,8 @@ public:
         : name_(std::move(name)), opt_(opt), seconds_(seconds), t0_(std::chrono::steady_clock::now()) {}
     std::string name() const override { return name_; }
     SolverOptions& options() override { return opt_; }
+    SolverCapabilities capabilities() const override { return solver_capabilities(name_); }
+    std::unique_ptr<Solver> clone() const override { return std::make_unique<DeadlineSolver>(*this); }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override {
         const double left = seconds_ - seconds_since(t0_);
         if (left <= 0) {
@@ -454,10 +456,7 @@ int main(int argc, char** argv) {
             G.max_iter = static_cast<int>(mi), G.seed = std::stoull(arg["seed"]);
             G.verbose = arg["verbose"] == "1", G.out = arg["out"];
             G.solvers = split(arg["solvers"]);
-            if (G.solvers.empty()) {
-                G.solvers.push_back("newton");
-                for (const auto& n : suite_solver_names()) G.solvers.push_back(n);
-            }
+            if (G.solvers.empty()) G.solvers = solver_names();
             for (const auto& n : G.solvers) make_solver(n, SolverOptions{});  // an unknown name fails here
             for (const auto& sc : G.schemes) parse_scheme(sc);
             if (G.Ls.empty() || G.qs.empty() || G.as.empty() || G.gammas.empty() || G.betas.empty() ||
@@ -487,10 +486,7 @@ int main(int argc, char** argv) {
         return stability_wet(G);
     }
     std::vector<std::string> solvers = split(arg["solvers"]);
-    if (solvers.empty()) {
-        solvers.push_back("newton");
-        for (const auto& s : suite_solver_names()) solvers.push_back(s);
-    }
+    if (solvers.empty()) solvers = solver_names();
     const std::string mode = arg["mode"], out = arg["out"];
     const double tol_abs = std::stod(arg["tol"]), rel_tol = std::stod(arg["rel-tol"]);
     const int max_iter = std::stoi(arg["max-iter"]);

@@ -8,7 +8,6 @@
 #include "fibernet/mechanics/equilibrium.hpp"
 #include "fibernet/mechanics/moduli.hpp"
 #include "fibernet/mechanics/stress.hpp"
-#include "fibernet/solve/newton.hpp"
 #include "fibernet/solve/solver.hpp"
 #include "fibernet/util/error.hpp"
 
@@ -87,11 +86,13 @@ void register_modulus(CLI::App& app) {
             std::vector<StrainMode> modes = {shear_mode(F, st.area), bulk_mode(F, st.area)};
             if (s.strain != StrainKind::Shear) modes.push_back(path_mode(s.strain, st.area));
             ModuliInfo info;
-            auto* newton = dynamic_cast<NewtonSolver*>(solver.get());  // reuse its symbolic analysis
             ModuliOptions mo;
             // What the solver accepted (tol, or Newton's round-off floor, measured on the Hessian it used).
             mo.equilibrium_tol = std::max({mo.equilibrium_tol, s.solver.tol, eq.result.grad_max});
-            const auto mods = linear_moduli(e, eq.q, F, modes, mo, &info, newton ? newton->factorization() : nullptr);
+            // The solver's factorization, already analyzed for this pattern (if it shares one).
+            LinearSolver* llt = solver->capabilities().shares_factorization ? solver->factorization_for(e.hessian_pattern())
+                                                                            : nullptr;
+            const auto mods = linear_moduli(e, eq.q, F, modes, mo, &info, llt);
             moduli = nlohmann::json::object();
             for (const auto& M : mods) {
                 ok = ok && M.ok;

@@ -3,7 +3,6 @@
 #include <chrono>
 
 #include "fibernet/mechanics/moduli.hpp"
-#include "fibernet/solve/newton.hpp"
 
 namespace fibernet {
 
@@ -46,8 +45,7 @@ Equilibrium relax(const NetworkEnergy& e, const Eigen::Matrix2d& F, Solver& solv
         // Linear response of the reference state along F(t) = I + t (F - I), taken to t = 1.
         const Eigen::VectorXd q_ref = e.dofs(e.model().x);
         ModuliInfo info;
-        auto* newton = dynamic_cast<NewtonSolver*>(&solver);  // share Newton's symbolic analysis
-        CholmodLLT* llt = newton ? &newton->factorization_for(e.hessian_pattern()) : nullptr;
+        LinearSolver* llt = solver.factorization_for(e.hessian_pattern());  // share the solver's symbolic analysis
         const StrainMode mode{"start", F - Eigen::Matrix2d::Identity(), 1.0};
         const auto m = linear_moduli(e, q_ref, Eigen::Matrix2d::Identity(), {mode}, {}, &info, llt);
         extra_factorizations = info.factorizations;

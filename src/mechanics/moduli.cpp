@@ -38,7 +38,7 @@ namespace {
 // is left 0. grad: the gradient at q, for the state check.
 // False (every modulus refused, the message says why) if q is not an equilibrium.
 bool relaxed_at(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
-                const std::vector<StrainMode>& modes, const ModuliOptions& opt, ModuliInfo& inf, CholmodLLT& llt,
+                const std::vector<StrainMode>& modes, const ModuliOptions& opt, ModuliInfo& inf, LinearSolver& llt,
                 Eigen::VectorXd& grad, std::vector<Modulus>& out) {
     const auto t_start = Clock::now();
     inf = ModuliInfo{};
@@ -125,7 +125,7 @@ void affine_predictions(const NetworkEnergy& e, const Eigen::VectorXd& q, const 
 // state leaves, and that difference joins each error (one more assembly, factorization and CG).
 void state_error(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
                  const std::vector<StrainMode>& modes, const ModuliOptions& opt, const Eigen::VectorXd& g,
-                 CholmodLLT& llt, std::vector<Modulus>& out, ModuliInfo& inf) {
+                 LinearSolver& llt, std::vector<Modulus>& out, ModuliInfo& inf) {
     const Eigen::VectorXd step = llt.solve(g);
     ModuliOptions o2 = opt;
     o2.state_error = false;
@@ -148,12 +148,12 @@ void state_error(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::
 
 std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
                                    const std::vector<StrainMode>& modes, const ModuliOptions& opt, ModuliInfo* info,
-                                   CholmodLLT* shared_llt) {
+                                   LinearSolver* shared_llt) {
     const auto t_start = Clock::now();
     ModuliInfo local;
     ModuliInfo& inf = info ? *info : local;
     CholmodLLT own;
-    CholmodLLT& llt = shared_llt ? *shared_llt : own;
+    LinearSolver& llt = shared_llt && shared_llt->definite() ? *shared_llt : own;  // a modulus needs the exact inverse
     Eigen::VectorXd g;
     std::vector<Modulus> out;
     if (!relaxed_at(e, q, F, modes, opt, inf, llt, g, out)) return out;
@@ -197,7 +197,7 @@ struct CgScales {
 // L = 20). The iterates stay in range(H) when b does, and c_k = b.u_k rises monotonically to b.H^+ b. (Restarting
 // from the true residual B - H U was tried: on the seed scheme it chases the round-off of H U and moves c further.)
 template <class HView>
-std::vector<ModeCG> pcg_modes(const HView& Hs, const CholmodLLT& llt, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Z0,
+std::vector<ModeCG> pcg_modes(const HView& Hs, const LinearSolver& llt, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Z0,
                               Eigen::MatrixXd& U, const CgScales& sc, const ModuliOptions& opt) {
     const int M = static_cast<int>(B.cols());
     std::vector<ModeCG> st(M);
@@ -298,7 +298,7 @@ struct ResidualError {
 };
 template <class HView>
 std::vector<ResidualError> true_residual_error(const HView& Hs, const Eigen::SparseMatrix<double>& H,
-                                               const CholmodLLT& llt, const Eigen::MatrixXd& B, const Eigen::MatrixXd& U,
+                                               const LinearSolver& llt, const Eigen::MatrixXd& B, const Eigen::MatrixXd& U,
                                                const Eigen::MatrixXd& V) {
     const Eigen::MatrixXd R = B - Hs * U, Z = llt.solve_many(R);
     const Eigen::SparseMatrix<double> Habs = H.cwiseAbs();
@@ -364,7 +364,7 @@ ComovingRhs comoving_rhs(const Eigen::SparseMatrix<double>& H, const std::vector
 
 std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const std::vector<StrainTerms>& terms,
                                     const std::vector<StrainMode>& modes, const ModuliOptions& opt, ModuliInfo* info,
-                                    CholmodLLT* shared_llt) {
+                                    LinearSolver* shared_llt) {
     const auto t_start = Clock::now();
     ModuliInfo local;
     ModuliInfo& inf = info ? *info : local;
@@ -404,7 +404,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
     const double seconds_setup = since(t0);
     const std::vector<Modulus> base = out;
     CholmodLLT own;
-    CholmodLLT& llt = shared_llt ? *shared_llt : own;
+    LinearSolver& llt = shared_llt && shared_llt->definite() ? *shared_llt : own;  // a modulus needs the exact inverse
     Eigen::SparseMatrix<double> Hd = H;  // H + delta D
     auto attempt = [&](double rel) -> bool {
         out = base;

@@ -11,6 +11,7 @@
 #include "fibernet/energy/capillary.hpp"
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/scene/scene_options.hpp"
+#include "fibernet/solve/solver_registry.hpp"
 #include "fibernet/util/error.hpp"
 
 namespace fibernet {
@@ -29,9 +30,10 @@ void Scene::check() const {
     if (wet.crossings != "fraction" && wet.seed != 1)  // the seed of that draw, likewise (--wet-seed)
         throw InputError(source + ": [wet].seed = " + std::to_string(wet.seed) + " is used only with crossings = "
                          "fraction (crossings is '" + wet.crossings + "')");
-    if (solver.eliminate && solver.name != "newton")  // else silently ignored by the other solvers
-        throw InputError(source + ": solver.eliminate = true is used only with solver = newton (solver is '" +
-                         solver.name + "')");
+    // Else silently ignored by the solver (an unknown solver is named here too).
+    if (solver.eliminate && !solver_capabilities(solver.name).eliminate)
+        throw InputError(source + ": solver.eliminate = true needs a solver with nonlinear elimination (newton); solver "
+                         "is '" + solver.name + "'");
     check_beta(wet.beta, source, "[wet].beta");
     // The law file last: a --law flag replaces the scene's before any file is opened.
     if (!wet.law.empty()) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "fibernet/solve/solver_loop.hpp"
 #include "solver_util.hpp"
 
 namespace fibernet {
@@ -13,87 +14,92 @@ void CgParams::check(const std::string& where) const {
 }
 
 CgSolver::CgSolver(const SolverOptions& opt, const CgParams& p) : opt_(opt), p_(p) {
-    detail::check_solver_options(opt_, name());
+    opt_.check(name());
     p_.check(name());
 }
 
-SolveResult CgSolver::minimize(Objective& f_in, Eigen::VectorXd& q) {
-    using Eigen::VectorXd;
-    detail::Clock clock;
-    detail::check_start(f_in, q, name());
-    detail::Counted f(f_in);
-    detail::Progress progress(name(), opt_.verbose);
-    const StrongWolfeLineSearch ls(p_.line_search);
-    const int n = f.size();
-    const int restart = p_.restart_every > 0 ? p_.restart_every : std::max(n, 1);
-    SolveResult r;
-    r.solver = name();
+namespace {
+using Eigen::VectorXd;
 
-    VectorXd g(n);
-    double fx = f.gradient(q, g);
-    double gmax = detail::max_abs(g);
-    int k = 0;
-    auto finish = [&](SolveStatus st, const std::string& msg) {
-        r.status = st, r.message = msg, r.iterations = k, r.evaluations = f.evals;
-        r.energy = fx, r.grad_max = gmax;
-        r.timings.total = clock.seconds();
-        progress.done(clock, to_string(st), k, fx, gmax);
-        return r;
-    };
-    if (!std::isfinite(fx) || !g.allFinite()) return finish(SolveStatus::NonFinite, "non-finite energy or gradient at the start");
-    const double f_scale = std::abs(fx);  // energy scale for the line search's round-off allowance
-    double gmax_best = gmax;
+// Polak-Ribiere+ conjugate gradients with restarts, as one iteration of the solver loop (solver_loop.hpp).
+class NonlinearCg : public IterativeMethod {
+public:
+    explicit NonlinearCg(const CgParams& p) : p_(p), ls_(p.line_search) {}
 
-    VectorXd d = -g, xn(n), gn(n);
-    bool steepest = true;
-    double alpha0 = 1.0 / std::max(g.norm(), 1e-300);
-    int no_decrease = 0, since_restart = 0;
-    while (true) {
-        if (gmax <= opt_.tol) return finish(SolveStatus::Converged, "max|g| <= tol");
-        if (k >= opt_.max_iter) return finish(SolveStatus::IterationLimit, "iteration limit reached");
-        if (opt_.max_seconds > 0 && clock.seconds() >= opt_.max_seconds)
-            return finish(SolveStatus::IterationLimit, "time limit reached");
+    Step start(SolverRun& run, VectorXd& q) override {
+        Objective& f = run.objective();
+        const int n = f.size();
+        restart_ = p_.restart_every > 0 ? p_.restart_every : std::max(n, 1);
+        g_.resize(n), xn_.resize(n), gn_.resize(n);
+        fx_ = f.gradient(q, g_);
+        gmax_ = detail::max_abs(g_);
+        if (!std::isfinite(fx_) || !g_.allFinite())
+            return Step::stop(SolveStatus::NonFinite, "non-finite energy or gradient at the start");
+        f_scale_ = std::abs(fx_);  // energy scale for the line search's round-off allowance
+        gmax_best_ = gmax_;
+        d_ = -g_;
+        alpha0_ = 1.0 / std::max(g_.norm(), 1e-300);
+        return Step::again();
+    }
 
+    Step iterate(SolverRun& run, VectorXd& q, int) override {
         detail::Clock cls;
-        const LineSearchResult lr = ls.search(f, q, fx, g, d, alpha0, xn, gn, f_scale);
-        r.timings.line_search += cls.seconds();
+        const LineSearchResult lr = ls_.search(run.objective(), q, fx_, g_, d_, alpha0_, xn_, gn_, f_scale_);
+        run.result().timings.line_search += cls.seconds();
         if (!lr.ok()) {
-            if (!steepest) {  // restart along -g once
-                d = -g, steepest = true, since_restart = 0;
-                alpha0 = 1.0 / std::max(g.norm(), 1e-300);
-                continue;
+            if (!steepest_) {  // restart along -g once
+                d_ = -g_, steepest_ = true, since_restart_ = 0;
+                alpha0_ = 1.0 / std::max(g_.norm(), 1e-300);
+                return Step::again();
             }
-            const SolveStatus st = lr.outcome == LineSearchOutcome::NonFinite ? SolveStatus::NonFinite
-                                                                              : SolveStatus::LineSearchFailed;
-            return finish(st, "line search: " + to_string(lr.outcome) + " after " + std::to_string(lr.evals) +
-                                  " evaluations at max|g| = " + show(gmax));
+            const SolveStatus st =
+                lr.outcome == LineSearchOutcome::NonFinite ? SolveStatus::NonFinite : SolveStatus::LineSearchFailed;
+            return Step::stop(st, "line search: " + to_string(lr.outcome) + " after " + std::to_string(lr.evals) +
+                                      " evaluations at max|g| = " + show(gmax_));
         }
-        ++k, ++since_restart;
+        ++since_restart_;
         // Progress: an energy decrease beyond round-off, or a new lowest max|g| (below round-off the energy
         // cannot tell, the gradient still can). A gradient inconsistent with the energy shows neither.
-        {
-            const double gn_max = detail::max_abs(gn);
-            const double noise = 1e-16 * std::abs(fx);  // any decrease beyond the last bits
-            const bool progress = lr.f < fx - noise || gn_max < 0.9 * gmax_best;
-            gmax_best = std::min(gmax_best, gn_max);
-            no_decrease = progress ? 0 : no_decrease + 1;
-        }
-        const double gd_old = g.dot(d);
-        double beta = std::max(0.0, gn.dot(gn - g) / g.squaredNorm());
-        if (since_restart >= restart) beta = 0, since_restart = 0;
-        q.swap(xn), g.swap(gn), fx = lr.f, gmax = detail::max_abs(g);
-        progress.tick(clock, k, fx, gmax);
-        if (gmax <= opt_.tol) continue;
-        if (no_decrease >= p_.stall_iterations)
-            return finish(SolveStatus::Stalled, "no energy decrease beyond round-off and no new minimum of max|g| for " +
-                                                    std::to_string(no_decrease) + " iterations at max|g| = " + show(gmax));
-        d = -g + beta * d;
-        steepest = beta == 0;
-        if (!(g.dot(d) < 0)) d = -g, steepest = true, since_restart = 0;
-        const double gd = g.dot(d);
-        alpha0 = lr.alpha * gd_old / gd;
-        if (!(alpha0 > 0) || !std::isfinite(alpha0)) alpha0 = 1.0 / std::max(g.norm(), 1e-300);
+        const double gn_max = detail::max_abs(gn_);
+        const double noise = 1e-16 * std::abs(fx_);  // any decrease beyond the last bits
+        const bool progress = lr.f < fx_ - noise || gn_max < 0.9 * gmax_best_;
+        gmax_best_ = std::min(gmax_best_, gn_max);
+        no_decrease_ = progress ? 0 : no_decrease_ + 1;
+        const double gd_old = g_.dot(d_);
+        double beta = std::max(0.0, gn_.dot(gn_ - g_) / g_.squaredNorm());
+        if (since_restart_ >= restart_) beta = 0, since_restart_ = 0;
+        q.swap(xn_), g_.swap(gn_), fx_ = lr.f, gmax_ = detail::max_abs(g_);
+        if (gmax_ <= run.options().tol) return Step::moved();
+        if (no_decrease_ >= p_.stall_iterations)
+            return Step::stop(SolveStatus::Stalled, "no energy decrease beyond round-off and no new minimum of max|g| for " +
+                                                        std::to_string(no_decrease_) + " iterations at max|g| = " +
+                                                        show(gmax_), true);
+        d_ = -g_ + beta * d_;
+        steepest_ = beta == 0;
+        if (!(g_.dot(d_) < 0)) d_ = -g_, steepest_ = true, since_restart_ = 0;
+        const double gd = g_.dot(d_);
+        alpha0_ = lr.alpha * gd_old / gd;
+        if (!(alpha0_ > 0) || !std::isfinite(alpha0_)) alpha0_ = 1.0 / std::max(g_.norm(), 1e-300);
+        return Step::moved();
     }
+
+    double energy() const override { return fx_; }
+    double grad_max() const override { return gmax_; }
+
+private:
+    const CgParams p_;
+    const StrongWolfeLineSearch ls_;
+    VectorXd g_, d_, xn_, gn_;
+    int restart_ = 1, no_decrease_ = 0, since_restart_ = 0;
+    bool steepest_ = true;
+    double fx_ = 0, gmax_ = 0, f_scale_ = 0, gmax_best_ = 0, alpha0_ = 1;
+};
+}  // namespace
+
+SolveResult CgSolver::minimize(Objective& f, Eigen::VectorXd& q) {
+    SolverRun run(name(), opt_, f, q);
+    NonlinearCg method(p_);
+    return run_iterations(run, method, q);
 }
 
 }  // namespace fibernet

@@ -28,6 +28,7 @@ struct CholmodLDL::Impl {
     bool ok = false;
     int negative = 0;
     double min_pivot = 0;
+    double shift = 0;  // of the last factorize(): solve()'s floor
 
     Impl() {
         cholmod_start(&c);
@@ -172,6 +173,7 @@ bool CholmodLDL::factorize(const Eigen::SparseMatrix<double>& upper, double shif
         throw std::logic_error("CholmodLDL::factorize: the matrix is not compressed or not of the analyzed pattern");
     m.S.gather(upper);
     cholmod_sparse S = m.S.view();
+    m.shift = shift;
     double beta[2] = {shift, 0.0};
     m.c.status = CHOLMOD_OK;
     m.ok = false, m.negative = 0, m.min_pivot = std::numeric_limits<double>::infinity();  // until this one succeeds
@@ -214,6 +216,10 @@ Eigen::VectorXd CholmodLDL::pivots() const {
 
 int CholmodLDL::negative_pivots() const { return impl_->negative; }
 double CholmodLDL::min_pivot() const { return impl_->min_pivot; }
+
+Eigen::VectorXd CholmodLDL::solve(const Eigen::VectorXd& b) const {
+    return solve_modified(b, impl_->shift > 0 ? impl_->shift : std::numeric_limits<double>::min());
+}
 
 Eigen::VectorXd CholmodLDL::solve_modified(const Eigen::VectorXd& b, double floor) const {
     if (!impl_->ok) throw std::logic_error("CholmodLDL::solve_modified without a successful factorization");

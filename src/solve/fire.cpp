@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "fibernet/solve/solver_loop.hpp"
 #include "solver_util.hpp"
 
 namespace fibernet {
@@ -21,8 +22,14 @@ void FireParams::check(const std::string& where) const {
 }
 
 FireSolver::FireSolver(const SolverOptions& opt, const FireParams& p) : opt_(opt), p_(p) {
-    detail::check_solver_options(opt_, name());
+    opt_.check(name());
     p_.check(name());
+}
+
+SolverCapabilities FireSolver::capabilities() const {
+    SolverCapabilities c;
+    c.hessian = p_.dt == 0;  // the automatic time step's Gershgorin bound
+    return c;
 }
 
 namespace {
@@ -36,93 +43,100 @@ double gershgorin(const Eigen::SparseMatrix<double>& H) {
         }
     return rs.size() ? rs.maxCoeff() : 0.0;
 }
-}  // namespace
 
-SolveResult FireSolver::minimize(Objective& f_in, Eigen::VectorXd& x) {
-    using Eigen::VectorXd;
-    detail::Clock clock;
-    detail::check_start(f_in, x, name());
-    detail::Counted f(f_in);
-    detail::Progress progress(name(), opt_.verbose);
-    const int n = f.size();
-    SolveResult r;
-    r.solver = name();
 
-    VectorXd g(n);
-    double fx = f.gradient(x, g);
-    double gmax = detail::max_abs(g);
-    int it = 0;
-    auto finish = [&](SolveStatus st, const std::string& msg) {
-        r.status = st, r.message = msg, r.iterations = it, r.evaluations = f.evals;
-        r.energy = fx, r.grad_max = gmax;
-        r.timings.total = clock.seconds();
-        progress.done(clock, to_string(st), it, fx, gmax);
-        return r;
-    };
-    if (!std::isfinite(fx) || !g.allFinite()) return finish(SolveStatus::NonFinite, "non-finite energy or gradient at the start");
+using Eigen::VectorXd;
 
-    double dt0 = p_.dt;
-    if (dt0 == 0) {
-        Eigen::SparseMatrix<double> H = f.hessian_pattern();
-        VectorXd gh(n);
-        detail::Clock c;
-        f.hessian(x, gh, H, false);
-        r.timings.assembly += c.seconds();
-        const double lam = gershgorin(H);
-        dt0 = lam > 0 && std::isfinite(lam) ? 1.0 / std::sqrt(lam) : 0.1;
+// FIRE (Bitzek et al. 2006; FIRE 2.0, Guenole et al. 2020) as one iteration of the solver loop (solver_loop.hpp): a
+// damped semi-implicit Euler step per iteration.
+class Fire : public IterativeMethod {
+public:
+    explicit Fire(const FireParams& p) : p_(p) {}
+
+    Step start(SolverRun& run, VectorXd& x) override {
+        Objective& f = run.objective();
+        const int n = f.size();
+        g_.resize(n);
+        fx_ = f.gradient(x, g_);
+        gmax_ = detail::max_abs(g_);
+        if (!std::isfinite(fx_) || !g_.allFinite())
+            return Step::stop(SolveStatus::NonFinite, "non-finite energy or gradient at the start");
+        double dt0 = p_.dt;
+        if (dt0 == 0) {
+            Eigen::SparseMatrix<double> H = f.hessian_pattern();
+            VectorXd gh(n);
+            detail::Clock c;
+            f.hessian(x, gh, H, false);
+            run.result().timings.assembly += c.seconds();
+            const double lam = gershgorin(H);
+            dt0 = lam > 0 && std::isfinite(lam) ? 1.0 / std::sqrt(lam) : 0.1;
+        }
+        dt_max_ = p_.dt_max_factor * dt0, dt_min_ = p_.dt_min_factor * dt0;
+        dt_ = dt0, alpha_ = p_.alpha0;
+        v_ = VectorXd::Zero(n);
+        return Step::again();
     }
-    const double dt_max = p_.dt_max_factor * dt0, dt_min = p_.dt_min_factor * dt0;
-    double dt = dt0, alpha = p_.alpha0;
-    int n_pos = 0, n_neg = 0, n_bad = 0;
-    VectorXd v = VectorXd::Zero(n), xold(n), gold(n);
 
-    while (true) {
-        if (gmax <= opt_.tol) return finish(SolveStatus::Converged, "max|g| <= tol");
-        if (it >= opt_.max_iter) return finish(SolveStatus::IterationLimit, "iteration limit reached");
-        if (opt_.max_seconds > 0 && clock.seconds() >= opt_.max_seconds)
-            return finish(SolveStatus::IterationLimit, "time limit reached");
-        ++it;
+    // Every iteration counts, also one whose step was undone.
+    Step iterate(SolverRun& run, VectorXd& x, int k) override {
+        const int it = k + 1;
         // Force F = -g.
-        const double P = -g.dot(v);
+        const double P = -g_.dot(v_);
         if (P > 0) {
-            ++n_pos, n_neg = 0;
-            if (n_pos > p_.n_delay) dt = std::min(dt * p_.f_inc, dt_max), alpha *= p_.f_alpha;
+            ++n_pos_, n_neg_ = 0;
+            if (n_pos_ > p_.n_delay) dt_ = std::min(dt_ * p_.f_inc, dt_max_), alpha_ *= p_.f_alpha;
         } else {
-            n_pos = 0, ++n_neg;
-            if (n_neg > p_.n_neg_max)
-                return finish(SolveStatus::Stalled, "power F.v <= 0 for " + std::to_string(n_neg - 1) +
-                                                        " consecutive steps at max|g| = " + show(gmax));
+            n_pos_ = 0, ++n_neg_;
+            if (n_neg_ > p_.n_neg_max)
+                return Step::stop(SolveStatus::Stalled, "power F.v <= 0 for " + std::to_string(n_neg_ - 1) +
+                                                            " consecutive steps at max|g| = " + show(gmax_), true);
             if (!(p_.initial_delay && it < p_.n_delay)) {
-                if (dt * p_.f_dec >= dt_min) dt *= p_.f_dec;
-                alpha = p_.alpha0;
+                if (dt_ * p_.f_dec >= dt_min_) dt_ *= p_.f_dec;
+                alpha_ = p_.alpha0;
             }
-            if (p_.half_step_back) x -= 0.5 * dt * v;
-            v.setZero();
+            if (p_.half_step_back) x -= 0.5 * dt_ * v_;
+            v_.setZero();
         }
         // Semi-implicit Euler with FIRE mixing.
-        v -= dt * g;
-        const double vn = v.norm(), fn = g.norm();
-        if (fn > 0) v = (1 - alpha) * v - (alpha * vn / fn) * g;
-        double step = dt;
-        const double vmax = detail::max_abs(v);
+        v_ -= dt_ * g_;
+        const double vn = v_.norm(), fn = g_.norm();
+        if (fn > 0) v_ = (1 - alpha_) * v_ - (alpha_ * vn / fn) * g_;
+        double step = dt_;
+        const double vmax = detail::max_abs(v_);
         if (p_.max_move > 0 && step * vmax > p_.max_move) step = p_.max_move / vmax;
-        xold = x, gold = g;
-        const double fold = fx;
-        x += step * v;
-        fx = f.gradient(x, g);
-        if (!std::isfinite(fx) || !g.allFinite()) {
+        xold_ = x, gold_ = g_;
+        const double fold = fx_;
+        x += step * v_;
+        fx_ = run.objective().gradient(x, g_);
+        if (!std::isfinite(fx_) || !g_.allFinite()) {
             // Undo: like an uphill step, with a smaller time step.
-            x = xold, g = gold, fx = fold, v.setZero();
-            dt = std::max(dt * p_.f_dec, dt_min), alpha = p_.alpha0, n_pos = 0;
-            if (++n_bad >= p_.max_nonfinite)
-                return finish(SolveStatus::NonFinite, "non-finite energy for " + std::to_string(n_bad) +
-                                                          " consecutive steps");
-            continue;
+            x = xold_, g_ = gold_, fx_ = fold, v_.setZero();
+            dt_ = std::max(dt_ * p_.f_dec, dt_min_), alpha_ = p_.alpha0, n_pos_ = 0;
+            if (++n_bad_ >= p_.max_nonfinite)
+                return Step::stop(SolveStatus::NonFinite, "non-finite energy for " + std::to_string(n_bad_) +
+                                                              " consecutive steps", true);
+            return Step::moved();
         }
-        n_bad = 0;
-        gmax = detail::max_abs(g);
-        progress.tick(clock, it, fx, gmax);
+        n_bad_ = 0;
+        gmax_ = detail::max_abs(g_);
+        return Step::moved();
     }
+
+    double energy() const override { return fx_; }
+    double grad_max() const override { return gmax_; }
+
+private:
+    const FireParams p_;
+    VectorXd g_, v_, xold_, gold_;
+    double fx_ = 0, gmax_ = 0, dt_ = 0, dt_max_ = 0, dt_min_ = 0, alpha_ = 0;
+    int n_pos_ = 0, n_neg_ = 0, n_bad_ = 0;
+};
+}  // namespace
+
+SolveResult FireSolver::minimize(Objective& f, Eigen::VectorXd& x) {
+    SolverRun run(name(), opt_, f, x);
+    Fire method(p_);
+    return run_iterations(run, method, x);
 }
 
 }  // namespace fibernet

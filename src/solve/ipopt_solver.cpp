@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 
+#include "fibernet/solve/solver_loop.hpp"
 #include "solver_util.hpp"
 
 namespace fibernet {
@@ -20,8 +21,14 @@ void IpoptParams::check(const std::string& where) const {
 }
 
 IpoptSolver::IpoptSolver(const SolverOptions& opt, const IpoptParams& p) : opt_(opt), p_(p) {
-    detail::check_solver_options(opt_, name());
+    opt_.check(name());
     p_.check(name());
+}
+
+SolverCapabilities IpoptSolver::capabilities() const {
+    SolverCapabilities c;
+    c.hessian = p_.exact_hessian;
+    return c;
 }
 
 namespace {
@@ -30,10 +37,8 @@ using Ipopt::Number;
 
 class Problem : public Ipopt::TNLP {
 public:
-    Problem(detail::Counted& f, const Eigen::VectorXd& q0, double max_seconds, detail::Clock& clock,
-            detail::Progress& progress)
-        : f_(f), q0_(q0), max_seconds_(max_seconds), clock_(clock), progress_(progress),
-          H_(f.hessian_pattern()), g_(q0.size()), gh_(q0.size()) {}
+    Problem(SolverRun& run, const Eigen::VectorXd& q0)
+        : run_(run), f_(run.objective()), q0_(q0), H_(f_.hessian_pattern()), g_(q0.size()), gh_(q0.size()) {}
 
     Eigen::VectorXd x_final;
     bool have_final = false, time_stop = false;
@@ -95,8 +100,8 @@ public:
     bool intermediate_callback(Ipopt::AlgorithmMode, Index iter, Number obj, Number, Number inf_du, Number, Number,
                                Number, Number, Number, Index, const Ipopt::IpoptData*,
                                Ipopt::IpoptCalculatedQuantities*) override {
-        progress_.tick(clock_, iter, obj, inf_du);
-        if (max_seconds_ > 0 && clock_.seconds() >= max_seconds_) {
+        run_.tick(iter, obj, inf_du);
+        if (run_.out_of_time()) {
             time_stop = true;
             return false;
         }
@@ -115,11 +120,9 @@ private:
         return ok_;
     }
 
-    detail::Counted& f_;
+    SolverRun& run_;
+    Objective& f_;
     Eigen::VectorXd q0_;
-    double max_seconds_;
-    detail::Clock& clock_;
-    detail::Progress& progress_;
     Eigen::SparseMatrix<double> H_;
     Eigen::VectorXd g_, gh_, xc_, xv_;
     double fx_ = 0;
@@ -146,27 +149,17 @@ const char* status_name(Ipopt::ApplicationReturnStatus s) {
 }  // namespace
 
 SolveResult IpoptSolver::minimize(Objective& f_in, Eigen::VectorXd& q) {
-    detail::Clock clock;
-    detail::check_start(f_in, q, name());
-    detail::Counted f(f_in);
-    detail::Progress progress(name(), opt_.verbose);
-    const int n = f.size();
-    SolveResult r;
-    r.solver = name();
-    Eigen::VectorXd g(n);
+    SolverRun run(name(), opt_, f_in, q);
+    SolveResult& r = run.result();
+    // Every exit reports the returned state evaluated afresh, not Ipopt's word for it.
     auto finish = [&](SolveStatus st, const std::string& msg) {
-        r.energy = f.gradient(q, g);  // the returned state, evaluated afresh
-        r.grad_max = detail::max_abs(g);
-        st = detail::verified_status(st, r.energy, g, opt_.tol, SolveStatus::Stalled);
-        r.status = st, r.message = msg, r.evaluations = f.evals;
-        r.timings.total = clock.seconds();
-        progress.done(clock, to_string(st), r.iterations, r.energy, r.grad_max);
-        return r;
+        return run.finish_verified(st, msg, q, SolveStatus::Stalled);
     };
     {
-        const double f0 = f.gradient(q, g);
+        Eigen::VectorXd g(q.size());
+        const double f0 = run.objective().gradient(q, g);
         if (!std::isfinite(f0) || !g.allFinite()) return finish(SolveStatus::NonFinite, "non-finite energy or gradient at the start");
-        if (detail::max_abs(g) <= opt_.tol || n == 0) return finish(SolveStatus::Converged, "max|g| <= tol at the start");
+        if (detail::max_abs(g) <= opt_.tol || q.size() == 0) return finish(SolveStatus::Converged, "max|g| <= tol at the start");
     }
 
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
@@ -183,7 +176,7 @@ SolveResult IpoptSolver::minimize(Objective& f_in, Eigen::VectorXd& q) {
     if (!p_.linear_solver.empty()) o.SetStringValue("linear_solver", p_.linear_solver);
     if (app->Initialize("") != Ipopt::Solve_Succeeded) return finish(SolveStatus::Failed, "Ipopt failed to initialize");
 
-    Ipopt::SmartPtr<Problem> prob = new Problem(f, q, opt_.max_seconds, clock, progress);
+    Ipopt::SmartPtr<Problem> prob = new Problem(run, q);
     const Ipopt::ApplicationReturnStatus st = app->OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(GetRawPtr(prob)));
     r.timings.assembly = prob->assembly_seconds;
     if (Ipopt::IsValid(app->Statistics())) r.iterations = app->Statistics()->IterationCount();

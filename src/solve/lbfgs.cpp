@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include "fibernet/solve/solver_loop.hpp"
 #include "hessian_factor.hpp"
 #include "solver_util.hpp"
 
@@ -19,160 +20,178 @@ void LbfgsParams::check(const std::string& where) const {
 }
 
 LbfgsSolver::LbfgsSolver(const SolverOptions& opt, const LbfgsParams& p) : opt_(opt), p_(p) {
-    detail::check_solver_options(opt_, name());
+    opt_.check(name());
     p_.check(name());
 }
 
-SolveResult LbfgsSolver::minimize(Objective& f_in, Eigen::VectorXd& q) {
-    using Eigen::VectorXd;
-    detail::Clock clock;
-    detail::check_start(f_in, q, name());
-    detail::Counted f(f_in);
-    detail::Progress progress(name(), opt_.verbose);
-    const StrongWolfeLineSearch ls(p_.line_search);
-    const int n = f.size();
-    SolveResult r;
-    r.solver = name();
+SolverCapabilities LbfgsSolver::capabilities() const {
+    SolverCapabilities c;
+    c.hessian = p_.hessian_h0;
+    return c;
+}
 
-    VectorXd g(n);
-    double fx = f.gradient(q, g);
-    double gmax = detail::max_abs(g);
+namespace {
+using Eigen::VectorXd;
 
-    // Memory: ring buffer of the newest m pairs.
-    const int m = p_.m;
-    Eigen::MatrixXd S(n, m), Y(n, m);
-    std::vector<double> rho(m);
-    int count = 0, newest = -1;
-    double gamma = 1;
+// Nocedal & Wright Alg. 7.4/7.5 as one iteration of the solver loop (solver_loop.hpp).
+class Lbfgs : public IterativeMethod {
+public:
+    explicit Lbfgs(const LbfgsParams& p) : p_(p), ls_(p.line_search) {}
 
-    detail::HessianFactor factor;
-    Eigen::SparseMatrix<double> H = f.hessian_pattern();
-    VectorXd gh(n);
-    int factor_iter = -1, factored_at = -1;  // window start; iteration of the last factorization
-    double gmax_at_factor = gmax;
-    int k = 0;
-    auto refactor = [&]() {
+    Step start(SolverRun& run, VectorXd& q) override {
+        Objective& f = run.objective();
+        const int n = f.size(), m = p_.m;
+        g_.resize(n), gh_.resize(n), d_.resize(n), xn_.resize(n), gn_.resize(n);
+        fx_ = f.gradient(q, g_);
+        gmax_ = detail::max_abs(g_);
+        S_.resize(n, m), Y_.resize(n, m), rho_.assign(m, 0.0), alpha_i_.resize(m);
+        H_ = f.hessian_pattern();
+        gmax_at_factor_ = gmax_;
+        if (!std::isfinite(fx_) || !g_.allFinite())
+            return Step::stop(SolveStatus::NonFinite, "non-finite energy or gradient at the start");
+        f_scale_ = std::abs(fx_);  // energy scale for the line search's round-off allowance
+        gmax_best_ = gmax_;
+        if (p_.hessian_h0 && !refactor(run, q))
+            return Step::stop(SolveStatus::Failed, "Hessian factorization failed at the start");
+        direction(run);
+        // Without curvature information, the first step of plain L-BFGS has unit length (LBFGSpp).
+        alpha0_ = p_.hessian_h0 ? 1.0 : 1.0 / d_.norm();
+        return Step::again();
+    }
+
+    Step iterate(SolverRun& run, VectorXd& q, int) override {
+        Objective& f = run.objective();
+        // A Hessian-scaled direction can be huge along near-null (floppy) modes: cap the first trial move.
+        const double dmax = detail::max_abs(d_);
+        if (dmax * alpha0_ > p_.max_move) alpha0_ = p_.max_move / dmax;
+        detail::Clock cls;
+        const LineSearchResult lr = ls_.search(f, q, fx_, g_, d_, alpha0_, xn_, gn_, f_scale_);
+        run.result().timings.line_search += cls.seconds();
+        if (!lr.ok()) return recover(run, q, lr);
+        restarts_ = 0;
+        ++k_;
+        // Progress: an energy decrease beyond round-off, or a new lowest max|g| (below round-off the energy
+        // cannot tell, the gradient still can). A gradient inconsistent with the energy shows neither.
+        const double gn_max = detail::max_abs(gn_);
+        const double noise = 1e-16 * std::abs(fx_);  // any decrease beyond the last bits
+        const bool progress = lr.f < fx_ - noise || gn_max < 0.9 * gmax_best_;
+        gmax_best_ = std::min(gmax_best_, gn_max);
+        no_decrease_ = progress ? 0 : no_decrease_ + 1;
+        remember(q);
+        q.swap(xn_), g_.swap(gn_), fx_ = lr.f, gmax_ = detail::max_abs(g_);
+        if (gmax_ <= run.options().tol) return Step::moved();
+        if (no_decrease_ >= p_.stall_iterations)
+            return Step::stop(SolveStatus::Stalled, "no energy decrease beyond round-off and no new minimum of max|g| for " +
+                                                        std::to_string(no_decrease_) + " iterations at max|g| = " +
+                                                        show(gmax_), true);
+        if (p_.hessian_h0 && p_.refactor_stall > 0 && k_ - factor_iter_ >= p_.refactor_stall) {
+            // A window of refactor_stall iterations since the last check: refactor if max|g| did not halve.
+            if (gmax_ > 0.5 * gmax_at_factor_) {
+                if (!refactor(run, q)) return Step::stop(SolveStatus::Failed, "Hessian factorization failed", true);
+            } else {
+                factor_iter_ = k_, gmax_at_factor_ = gmax_;  // progress: keep the factor, start a new window
+            }
+        }
+        direction(run);
+        if (!(g_.dot(d_) < 0)) {
+            count_ = 0, newest_ = -1;
+            direction(run);
+        }
+        alpha0_ = 1.0;
+        return Step::moved();
+    }
+
+    double energy() const override { return fx_; }
+    double grad_max() const override { return gmax_; }
+
+private:
+    // A failed line search: forget the memory (and refactor at the current point) once per failure and go along
+    // -H0 g; give up when there is nothing left to forget.
+    Step recover(SolverRun& run, const VectorXd& q, const LineSearchResult& lr) {
+        const bool stale = count_ > 0 || (p_.hessian_h0 && factored_at_ != k_);
+        if (restarts_ < p_.max_restarts && stale) {
+            ++restarts_;
+            count_ = 0, newest_ = -1;
+            if (p_.hessian_h0 && factored_at_ != k_ && !refactor(run, q))
+                return Step::stop(SolveStatus::Failed, "Hessian factorization failed");
+            direction(run);
+            alpha0_ = p_.hessian_h0 ? 1.0 : 1.0 / d_.norm();
+            return Step::again();
+        }
+        const SolveStatus st =
+            lr.outcome == LineSearchOutcome::NonFinite ? SolveStatus::NonFinite : SolveStatus::LineSearchFailed;
+        return Step::stop(st, "line search: " + to_string(lr.outcome) + " after " + std::to_string(lr.evals) +
+                                  " evaluations at max|g| = " + show(gmax_));
+    }
+
+    // The new pair (s, y) into the ring buffer of the newest m, if its curvature is positive.
+    void remember(const VectorXd& q) {
+        const int m = p_.m, slot = (newest_ + 1) % m;
+        S_.col(slot) = xn_ - q;
+        Y_.col(slot) = gn_ - g_;
+        const double sy = S_.col(slot).dot(Y_.col(slot)), yy = Y_.col(slot).squaredNorm();
+        if (sy > 1e-14 * yy && yy > 0) {
+            rho_[slot] = 1 / sy;
+            gamma_ = sy / yy;
+            newest_ = slot;
+            count_ = std::min(count_ + 1, m);
+        }
+    }
+
+    bool refactor(SolverRun& run, const VectorXd& q) {
+        SolveResult& r = run.result();
         detail::Clock c;
-        f.hessian(q, gh, H, true);
+        run.objective().hessian(q, gh_, H_, true);
         r.timings.assembly += c.seconds();
         detail::Clock c2;
-        const bool ok = factor.factorize(H, p_.shift);
+        const bool ok = factor_.factorize(H_, p_.shift);
         r.timings.factorization += c2.seconds();
         ++r.factorizations;
-        factor_iter = factored_at = k, gmax_at_factor = gmax;
+        factor_iter_ = factored_at_ = k_, gmax_at_factor_ = gmax_;
         return ok;
-    };
+    }
+
     // d = -H_k g by the two-loop recursion.
-    VectorXd d(n), alpha_i(m);
-    auto direction = [&]() {
-        VectorXd v = g;
-        for (int c = 0, i = newest; c < count; ++c, i = (i + m - 1) % m) {
-            alpha_i[i] = rho[i] * S.col(i).dot(v);
-            v -= alpha_i[i] * Y.col(i);
+    void direction(SolverRun& run) {
+        const int m = p_.m;
+        VectorXd v = g_;
+        for (int c = 0, i = newest_; c < count_; ++c, i = (i + m - 1) % m) {
+            alpha_i_[i] = rho_[i] * S_.col(i).dot(v);
+            v -= alpha_i_[i] * Y_.col(i);
         }
         if (p_.hessian_h0) {
             detail::Clock c;
-            v = factor.solve(v);
-            r.timings.solve += c.seconds();
+            v = factor_.solve(v);
+            run.result().timings.solve += c.seconds();
         } else {
-            v *= gamma;
+            v *= gamma_;
         }
-        for (int c = 0, i = (newest - count + 1 + m) % m; c < count; ++c, i = (i + 1) % m) {
-            const double b = rho[i] * Y.col(i).dot(v);
-            v += (alpha_i[i] - b) * S.col(i);
+        for (int c = 0, i = (newest_ - count_ + 1 + m) % m; c < count_; ++c, i = (i + 1) % m) {
+            const double b = rho_[i] * Y_.col(i).dot(v);
+            v += (alpha_i_[i] - b) * S_.col(i);
         }
-        d = -v;
-    };
-    auto finish = [&](SolveStatus st, const std::string& msg) {
-        r.status = st, r.message = msg, r.iterations = k, r.evaluations = f.evals;
-        r.energy = fx, r.grad_max = gmax;
-        r.timings.total = clock.seconds();
-        progress.done(clock, to_string(st), k, fx, gmax);
-        return r;
-    };
-
-    if (!std::isfinite(fx) || !g.allFinite()) return finish(SolveStatus::NonFinite, "non-finite energy or gradient at the start");
-    const double f_scale = std::abs(fx);  // energy scale for the line search's round-off allowance
-    double gmax_best = gmax;
-    if (p_.hessian_h0 && !refactor()) return finish(SolveStatus::Failed, "Hessian factorization failed at the start");
-
-    direction();
-    // Without curvature information, the first step of plain L-BFGS has unit length (LBFGSpp).
-    double alpha0 = p_.hessian_h0 ? 1.0 : 1.0 / d.norm();
-    int restarts = 0, no_decrease = 0;
-    VectorXd xn(n), gn(n);
-    while (true) {
-        if (gmax <= opt_.tol) return finish(SolveStatus::Converged, "max|g| <= tol");
-        if (k >= opt_.max_iter) return finish(SolveStatus::IterationLimit, "iteration limit reached");
-        if (opt_.max_seconds > 0 && clock.seconds() >= opt_.max_seconds)
-            return finish(SolveStatus::IterationLimit, "time limit reached");
-
-        // A Hessian-scaled direction can be huge along near-null (floppy) modes: cap the first trial move.
-        const double dmax = detail::max_abs(d);
-        if (dmax * alpha0 > p_.max_move) alpha0 = p_.max_move / dmax;
-        detail::Clock cls;
-        const LineSearchResult lr = ls.search(f, q, fx, g, d, alpha0, xn, gn, f_scale);
-        r.timings.line_search += cls.seconds();
-        if (!lr.ok()) {
-            // Recover once per failure: forget the memory (and refactor at the current point), go along -H0 g.
-            const bool stale = count > 0 || (p_.hessian_h0 && factored_at != k);
-            if (restarts < p_.max_restarts && stale) {
-                ++restarts;
-                count = 0, newest = -1;
-                if (p_.hessian_h0 && factored_at != k && !refactor())
-                    return finish(SolveStatus::Failed, "Hessian factorization failed");
-                direction();
-                alpha0 = p_.hessian_h0 ? 1.0 : 1.0 / d.norm();
-                continue;
-            }
-            const SolveStatus st = lr.outcome == LineSearchOutcome::NonFinite ? SolveStatus::NonFinite
-                                                                              : SolveStatus::LineSearchFailed;
-            return finish(st, "line search: " + to_string(lr.outcome) + " after " + std::to_string(lr.evals) +
-                                  " evaluations at max|g| = " + show(gmax));
-        }
-        restarts = 0;
-        ++k;
-        // Progress: an energy decrease beyond round-off, or a new lowest max|g| (below round-off the energy
-        // cannot tell, the gradient still can). A gradient inconsistent with the energy shows neither.
-        {
-            const double gn_max = detail::max_abs(gn);
-            const double noise = 1e-16 * std::abs(fx);  // any decrease beyond the last bits
-            const bool progress = lr.f < fx - noise || gn_max < 0.9 * gmax_best;
-            gmax_best = std::min(gmax_best, gn_max);
-            no_decrease = progress ? 0 : no_decrease + 1;
-        }
-        // New pair.
-        const int slot = (newest + 1) % m;
-        S.col(slot) = xn - q;
-        Y.col(slot) = gn - g;
-        const double sy = S.col(slot).dot(Y.col(slot)), yy = Y.col(slot).squaredNorm();
-        if (sy > 1e-14 * yy && yy > 0) {  // keep only pairs with positive curvature
-            rho[slot] = 1 / sy;
-            gamma = sy / yy;
-            newest = slot;
-            count = std::min(count + 1, m);
-        }
-        q.swap(xn), g.swap(gn), fx = lr.f, gmax = detail::max_abs(g);
-        progress.tick(clock, k, fx, gmax);
-        if (gmax <= opt_.tol) continue;
-        if (no_decrease >= p_.stall_iterations)
-            return finish(SolveStatus::Stalled, "no energy decrease beyond round-off and no new minimum of max|g| for " +
-                                                    std::to_string(no_decrease) + " iterations at max|g| = " + show(gmax));
-        if (p_.hessian_h0 && p_.refactor_stall > 0 && k - factor_iter >= p_.refactor_stall) {
-            // A window of refactor_stall iterations since the last check: refactor if max|g| did not halve.
-            if (gmax > 0.5 * gmax_at_factor) {
-                if (!refactor()) return finish(SolveStatus::Failed, "Hessian factorization failed");
-            } else {
-                factor_iter = k, gmax_at_factor = gmax;  // progress: keep the factor, start a new window
-            }
-        }
-        direction();
-        if (!(g.dot(d) < 0)) {
-            count = 0, newest = -1;
-            direction();
-        }
-        alpha0 = 1.0;
+        d_ = -v;
     }
+
+    const LbfgsParams p_;
+    const StrongWolfeLineSearch ls_;
+    VectorXd g_, gh_, d_, xn_, gn_, alpha_i_;
+    Eigen::MatrixXd S_, Y_;
+    std::vector<double> rho_;
+    int count_ = 0, newest_ = -1;
+    double gamma_ = 1;
+    detail::HessianFactor factor_;
+    Eigen::SparseMatrix<double> H_;
+    int k_ = 0, factor_iter_ = -1, factored_at_ = -1;  // iterations; window start; iteration of the last factorization
+    double fx_ = 0, gmax_ = 0, gmax_at_factor_ = 0, f_scale_ = 0, gmax_best_ = 0, alpha0_ = 1;
+    int restarts_ = 0, no_decrease_ = 0;
+};
+}  // namespace
+
+SolveResult LbfgsSolver::minimize(Objective& f, Eigen::VectorXd& q) {
+    SolverRun run(name(), opt_, f, q);
+    Lbfgs method(p_);
+    return run_iterations(run, method, q);
 }
 
 }  // namespace fibernet

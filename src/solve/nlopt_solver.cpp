@@ -5,6 +5,7 @@
 #include <nlopt.hpp>
 #include <vector>
 
+#include "fibernet/solve/solver_loop.hpp"
 #include "solver_util.hpp"
 
 namespace fibernet {
@@ -17,7 +18,7 @@ void NloptParams::check(const std::string& where) const {
 
 NloptSolver::NloptSolver(NloptMethod method, const SolverOptions& opt, const NloptParams& p)
     : method_(method), opt_(opt), p_(p) {
-    detail::check_solver_options(opt_, name());
+    opt_.check(name());
     p_.check(name());
 }
 
@@ -49,7 +50,7 @@ const char* result_name(nlopt::result r) {
 }
 
 struct Watch {
-    detail::Counted* f;
+    SolverRun* run;
     double tol;
     Eigen::VectorXd x, g;
     bool hit = false;        // a point with max|g| <= tol was met: NLopt was stopped there
@@ -57,10 +58,8 @@ struct Watch {
     double best_f = std::numeric_limits<double>::infinity();
     Eigen::VectorXd best_x;
     int nonfinite = 0;
-    double max_seconds = 0;  // NLopt checks maxtime only between its outer iterations (TNEWTON's inner CG
-    bool time_stop = false;  // loop can overrun it many times over), so the adapter enforces it too
-    detail::Clock* clock;
-    detail::Progress* progress;
+    bool time_stop = false;  // NLopt checks maxtime only between its outer iterations (TNEWTON's inner CG loop can
+                             // overrun it many times over), so the adapter enforces it too
 };
 
 double callback(unsigned n, const double* xp, double* grad, void* data) {
@@ -68,12 +67,12 @@ double callback(unsigned n, const double* xp, double* grad, void* data) {
     // Once stopped, NLopt's inner loops (TNEWTON's CG) may still call back until they check the stop flag:
     // answer at once, without evaluating.
     if (w.hit || w.time_stop) throw nlopt::forced_stop();
-    if (w.max_seconds > 0 && w.clock->seconds() >= w.max_seconds) {
+    if (w.run->out_of_time()) {
         w.time_stop = true;
         throw nlopt::forced_stop();
     }
     w.x = Eigen::Map<const Eigen::VectorXd>(xp, n);
-    const double fx = w.f->gradient(w.x, w.g);
+    const double fx = w.run->objective().gradient(w.x, w.g);
     const bool finite = std::isfinite(fx) && w.g.allFinite();
     if (!finite) {
         ++w.nonfinite;
@@ -83,7 +82,7 @@ double callback(unsigned n, const double* xp, double* grad, void* data) {
     if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = w.g;
     const double gmax = detail::max_abs(w.g);
     if (fx < w.best_f) w.best_f = fx, w.best_x = w.x;
-    w.progress->tick(*w.clock, w.f->evals, fx, gmax);
+    w.run->tick(w.run->objective().evaluations, fx, gmax);
     if (gmax <= w.tol) {
         w.hit = true, w.hit_x = w.x;
         throw nlopt::forced_stop();
@@ -93,28 +92,18 @@ double callback(unsigned n, const double* xp, double* grad, void* data) {
 }  // namespace
 
 SolveResult NloptSolver::minimize(Objective& f_in, Eigen::VectorXd& q) {
-    detail::Clock clock;
-    detail::check_start(f_in, q, name());
-    detail::Counted f(f_in);
-    detail::Progress progress(name(), opt_.verbose);
+    SolverRun run(name(), opt_, f_in, q);
+    CountedObjective& f = run.objective();
     const int n = f.size();
-    SolveResult r;
-    r.solver = name();
-
-    Eigen::VectorXd g(n);
+    // Every exit reports the state we return, evaluated afresh: never NLopt's word for it. NLopt reports no iteration
+    // count: its evaluations stand for it.
     auto finish = [&](SolveStatus st, const std::string& msg) {
-        // Report the state we return, evaluated afresh: never NLopt's word for it.
-        r.energy = f.gradient(q, g);
-        r.grad_max = detail::max_abs(g);
-        st = detail::verified_status(st, r.energy, g, opt_.tol, SolveStatus::Failed);
-        r.status = st, r.message = msg, r.evaluations = f.evals;
-        r.iterations = f.evals;  // NLopt reports no iteration count
-        r.timings.total = clock.seconds();
-        progress.done(clock, to_string(st), r.iterations, r.energy, r.grad_max);
-        return r;
+        run.result().iterations = f.evaluations + 1;
+        return run.finish_verified(st, msg, q, SolveStatus::Failed);
     };
 
     // Start point first: a converged or non-finite start needs no NLopt call.
+    Eigen::VectorXd g(n);
     const double f0 = f.gradient(q, g);
     if (!std::isfinite(f0) || !g.allFinite()) return finish(SolveStatus::NonFinite, "non-finite energy or gradient at the start");
     if (detail::max_abs(g) <= opt_.tol) return finish(SolveStatus::Converged, "max|g| <= tol at the start");
@@ -125,7 +114,7 @@ SolveResult NloptSolver::minimize(Objective& f_in, Eigen::VectorXd& q) {
     if (method_ == NloptMethod::Var2) alg = nlopt::LD_VAR2;
     nlopt::opt o(alg, static_cast<unsigned>(n));
     Watch w;
-    w.f = &f, w.tol = opt_.tol, w.clock = &clock, w.progress = &progress, w.max_seconds = opt_.max_seconds;
+    w.run = &run, w.tol = opt_.tol;
     w.best_f = f0, w.best_x = q;
     o.set_min_objective(callback, &w);
     o.set_maxeval(opt_.max_iter);

@@ -1,18 +1,19 @@
 #include "fibernet/solve/solver.hpp"
 
-#include "fibernet/solve/newton.hpp"
-#include "fibernet/solve/solver_suite.hpp"
+#include "fibernet/solve/solver_registry.hpp"
 #include "fibernet/util/error.hpp"
 
 namespace fibernet {
 
-// The registry of solvers `--solver` can name. Add one `if` per solver.
+void SolverOptions::check(const std::string& where) const {
+    check_value(tol > 0, tol, where, "tol", "must be > 0");
+    check_value(max_iter > 0, max_iter, where, "max_iter", "must be > 0");
+    check_value(max_seconds >= 0, max_seconds, where, "max_seconds", "must be >= 0 (0 = no limit)");
+    elimination.check(where);
+}
+
 std::unique_ptr<Solver> make_solver(const std::string& name, const SolverOptions& opt) {
-    if (name == "newton") return std::make_unique<NewtonSolver>(opt);
-    if (auto s = make_suite_solver(name, opt)) return s;  // issue 5: lbfgs, nlopt-*, ipopt, fire, cg
-    std::string known = "newton";
-    for (const auto& n : suite_solver_names()) known += ", " + n;
-    throw InputError("solver '" + name + "' is unknown (known: " + known + ")");
+    return solver_entry(name).make(opt);
 }
 
 }  // namespace fibernet

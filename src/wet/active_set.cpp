@@ -510,7 +510,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
     bool capped = cap;
     bool resume = false;  // the last round was cut at round_iterations: the next one resumes its solve
     // Local rounds were designed and measured with Newton (docs/wet.md, "Local rounds").
-    const bool use_local = opt.local_fraction > 0 && params.beta > 0 && solver.name() == "newton";
+    const bool use_local = opt.local_fraction > 0 && params.beta > 0 && solver.capabilities().newton_steps;
     std::vector<char> region;  // non-empty: the next round is local, on these nodes
     ElementIncidence inc;      // of the energy the next local round solves (segment and hinge rows built once)
     std::unique_ptr<WetEnergy> next;
@@ -549,7 +549,7 @@ ActiveSetResult relax_wet(const NetworkEnergy& dry, const Eigen::Matrix2d& F, co
             // for bit on any number of threads. Results are gathered in the parts' order. (One thread with Newton's
             // verbose lines, which would interleave.)
             const int threads = so.verbose ? 1 : std::max(1, std::min(thread_count(), static_cast<int>(parts.size())));
-            while (static_cast<int>(part_solvers.size()) < threads) part_solvers.push_back(make_solver(solver.name(), so));
+            while (static_cast<int>(part_solvers.size()) < threads) part_solvers.push_back(solver.clone());
             std::vector<Solver*> pool;
             for (int k = 0; k < threads; ++k) part_solvers[k]->options() = so, pool.push_back(part_solvers[k].get());
             std::mutex pool_mutex;

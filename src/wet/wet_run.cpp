@@ -116,7 +116,7 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     // Rounds are capped in Newton iterations (active_set.hpp); first-order solvers' iterations are cheap and many.
     // Local rounds were designed and measured with Newton (docs/wet.md, "Local rounds"): other solvers solve globally.
     ActiveSetOptions as = options;
-    if (opt.solver != "newton") as.round_iterations = 0, as.local_fraction = 0;
+    if (!solver->capabilities().newton_steps) as.round_iterations = 0, as.local_fraction = 0;
     run.active = relax_wet(dry, F, opt.params, bridges, *solver, run.wet.q, as);
     run.seconds_wet_solve = run.active.seconds_solve;
     run.seconds_events = run.active.seconds_events;

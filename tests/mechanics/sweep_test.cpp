@@ -26,7 +26,7 @@ std::vector<SweepRow> sweep_rows(const NetworkEnergy& e, const SweepParams& p, S
     so.max_iter = max_iter;
     auto solver = make_solver("newton", so);
     so.max_iter = snap_iter;
-    auto snap = make_solver("newton", so);
+    auto snap = snap_iter > 0 ? make_solver("newton", so) : nullptr;  // max_iter = 0 is refused
     std::vector<SweepRow> rows;
     std::atomic<bool> stop{false};
     SweepCallbacks cb;
@@ -36,7 +36,7 @@ std::vector<SweepRow> sweep_rows(const NetworkEnergy& e, const SweepParams& p, S
         if (last) *last = s;
         if (r.step == stop_after) stop = true;
     };
-    SweepOutcome o = run_sweep(e, p, *solver, cb, resume, snap_iter > 0 ? snap.get() : nullptr);
+    SweepOutcome o = run_sweep(e, p, *solver, cb, resume, snap.get());
     if (out) *out = o;
     return rows;
 }

@@ -369,6 +369,8 @@ public:
     Scripted(std::vector<Eigen::VectorXd> q, std::vector<SolveStatus> st) : q_(std::move(q)), st_(std::move(st)) {}
     std::string name() const override { return "scripted"; }
     SolverOptions& options() override { return opt_; }
+    SolverCapabilities capabilities() const override { return {}; }
+    std::unique_ptr<Solver> clone() const override { return std::make_unique<Scripted>(*this); }
     SolveResult minimize(Objective&, Eigen::VectorXd& q) override {
         const size_t n = q_.size(), k = k_ < n ? k_ : n - 2 + (k_ - n) % 2;
         q = q_[k];

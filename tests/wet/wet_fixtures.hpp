@@ -57,6 +57,8 @@ public:
     explicit Recording(SolverOptions o) : opt_(o), inner_(o) {}
     std::string name() const override { return "newton"; }
     SolverOptions& options() override { return opt_; }
+    SolverCapabilities capabilities() const override { return inner_.capabilities(); }
+    std::unique_ptr<Solver> clone() const override { return inner_.clone(); }  // a thread's solver: not recorded
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override {
         caps.push_back(opt_.max_iter);
         warm.push_back(opt_.warm_start);

@@ -94,18 +94,18 @@ struct StrainTerms {
     bool comoving = false;
     double E_tt_size = 0;
 };
-class CholmodLLT;
+class LinearSolver;
 std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const std::vector<StrainTerms>& terms,
                                     const std::vector<StrainMode>& modes, const ModuliOptions& opt = {},
-                                    ModuliInfo* info = nullptr, CholmodLLT* llt = nullptr);
+                                    ModuliInfo* info = nullptr, LinearSolver* llt = nullptr);
 // V x_i for every free node i (x: all nodes' positions, 2 per node), in q's layout.
 Eigen::VectorXd affine_velocity(const NetworkEnergy& e, const Eigen::VectorXd& x, const Eigen::Matrix2d& V);
 
-// llt: an optional CHOLMOD wrapper already analyzed for e.hessian_pattern() (e.g. NewtonSolver::factorization()
-// after the equilibrium solve), so that the modulus costs one numeric factorization and no symbolic analysis.
-// Its numeric factor is overwritten.
+// llt: an optional definite linear solver (linear_solver.hpp) already analyzed for e.hessian_pattern() (e.g.
+// Solver::factorization_for() after the equilibrium solve), so that the modulus costs one numeric factorization and
+// no symbolic analysis; one that is not definite() is not used. Its numeric factor is overwritten.
 std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
                                    const std::vector<StrainMode>& modes, const ModuliOptions& opt = {},
-                                   ModuliInfo* info = nullptr, CholmodLLT* llt = nullptr);
+                                   ModuliInfo* info = nullptr, LinearSolver* llt = nullptr);
 
 }  // namespace fibernet

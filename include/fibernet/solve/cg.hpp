@@ -4,6 +4,7 @@
 // unknowns), whenever beta would be negative, and whenever the new direction is not a descent direction.
 // Line search: strong Wolfe (line_search.hpp) with c2 = 0.1, as PR+ needs; the first trial step is
 // alpha_prev * g_prev.d_prev / g.d (Nocedal & Wright eq. 3.60).
+#include <memory>
 #include <string>
 
 #include "fibernet/solve/line_search.hpp"
@@ -30,6 +31,8 @@ public:
     std::string name() const override { return "cg"; }
     SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
+    SolverCapabilities capabilities() const override { return {}; }
+    std::unique_ptr<Solver> clone() const override { return std::make_unique<CgSolver>(opt_, p_); }
 
 private:
     SolverOptions opt_;

@@ -13,7 +13,10 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <string>
 #include <vector>
+
+#include "fibernet/solve/linear_solver.hpp"
 
 namespace fibernet {
 
@@ -25,17 +28,19 @@ namespace fibernet {
 // The parts' rows are CHOLMOD's arithmetic exactly, the separator's differ in the last bits (the same terms summed in
 // another order), and the factor is the same on any number of threads. Late in a 1e4-fiber wet run it factors in
 // 0.37 s against 0.56 s on one thread in CHOLMOD's own order (bench_factor; 0.50 s in this order on one thread).
-class CholmodLDL {
+class CholmodLDL : public LinearSolver {
 public:
     static constexpr int kSplitMin = 20000;
     explicit CholmodLDL(int split_min = kSplitMin);
     ~CholmodLDL();
     CholmodLDL(const CholmodLDL&) = delete;
     CholmodLDL& operator=(const CholmodLDL&) = delete;
+    std::string name() const override { return "cholmod-ldl"; }
+    bool definite() const override { return false; }
 
     // Symbolic analysis of an upper-triangular CSC pattern (values ignored).
-    void analyze(const Eigen::SparseMatrix<double>& upper);
-    bool analyzed() const;
+    void analyze(const Eigen::SparseMatrix<double>& upper) override;
+    bool analyzed() const override;
     // The analyzed order's independent row ranges [0, a) and [a, b) (factored at the same time); a = b = 0: none.
     int split_a() const;
     int split_b() const;
@@ -44,12 +49,15 @@ public:
     const std::vector<int>& order() const;
     Eigen::VectorXd pivots() const;
     // Numeric LDL^T of H + shift I (H with the analyzed pattern). False on a zero or non-finite pivot.
-    bool factorize(const Eigen::SparseMatrix<double>& upper, double shift = 0.0);
+    bool factorize(const Eigen::SparseMatrix<double>& upper, double shift = 0.0) override;
     // Pivots of the last factorization that were negative, and the smallest one.
-    int negative_pivots() const;
+    int negative_pivots() const override;
     double min_pivot() const;
     // x = P^T L^-T Dm^-1 L^-1 P b with Dm_j = max(|D_j|, floor) (floor > 0).
     Eigen::VectorXd solve_modified(const Eigen::VectorXd& b, double floor) const;
+    // LinearSolver: solve_modified with the floor the last factorize() shifted by (the smallest positive number if that
+    // was not positive).
+    Eigen::VectorXd solve(const Eigen::VectorXd& b) const override;
 
 private:
     struct Impl;

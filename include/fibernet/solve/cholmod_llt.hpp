@@ -7,27 +7,32 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <string>
+
+#include "fibernet/solve/linear_solver.hpp"
 
 namespace fibernet {
 
-class CholmodLLT {
+class CholmodLLT : public LinearSolver {
 public:
     CholmodLLT();
     ~CholmodLLT();
     CholmodLLT(const CholmodLLT&) = delete;
     CholmodLLT& operator=(const CholmodLLT&) = delete;
+    std::string name() const override { return "cholmod-llt"; }
+    bool definite() const override { return true; }
 
     // Symbolic analysis of an upper-triangular CSC pattern (values ignored). Called once per model.
-    void analyze(const Eigen::SparseMatrix<double>& upper);
-    bool analyzed() const;
+    void analyze(const Eigen::SparseMatrix<double>& upper) override;
+    bool analyzed() const override;
     // Numeric factorization of H + shift I (H: upper triangle with the analyzed pattern; a matrix of another size
     // or number of entries is analyzed first). False if not positive definite (or non-finite); the previous
     // factor is then unusable.
-    bool factorize(const Eigen::SparseMatrix<double>& upper, double shift = 0.0);
+    bool factorize(const Eigen::SparseMatrix<double>& upper, double shift = 0.0) override;
     // x = (H + shift I)^{-1} b with the last successful factor.
-    Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
+    Eigen::VectorXd solve(const Eigen::VectorXd& b) const override;
     // The same for several right-hand sides at once (columns of B).
-    Eigen::MatrixXd solve_many(const Eigen::MatrixXd& B) const;
+    Eigen::MatrixXd solve_many(const Eigen::MatrixXd& B) const override;
 
 private:
     struct Impl;

@@ -11,6 +11,7 @@
 // the Hessian at the start: explicit dynamics is stable for dt < 2 / sqrt(lambda_max), and FIRE grows dt
 // (up to dt_max = 10 dt0) and cuts it back where that overshoots.
 // A step into +inf/NaN energy is undone like an uphill step (v = 0, dt halved).
+#include <memory>
 #include <string>
 
 #include "fibernet/solve/solver.hpp"
@@ -41,6 +42,8 @@ public:
     std::string name() const override { return "fire"; }
     SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
+    SolverCapabilities capabilities() const override;
+    std::unique_ptr<Solver> clone() const override { return std::make_unique<FireSolver>(opt_, p_); }
 
 private:
     SolverOptions opt_;

@@ -11,6 +11,7 @@
 //   Maximum_Iterations/CpuTime_Exceeded, our wall-time stop -> IterationLimit; Restoration_Failed ->
 //   LineSearchFailed; Invalid_Number_Detected -> NonFinite; anything else -> Failed.
 // A point outside the domain (+inf energy) is an evaluation error, on which Ipopt cuts the step.
+#include <memory>
 #include <string>
 
 #include "fibernet/solve/solver.hpp"
@@ -31,6 +32,8 @@ public:
     std::string name() const override { return "ipopt"; }
     SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
+    SolverCapabilities capabilities() const override;
+    std::unique_ptr<Solver> clone() const override { return std::make_unique<IpoptSolver>(opt_, p_); }
 
 private:
     SolverOptions opt_;

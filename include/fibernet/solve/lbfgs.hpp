@@ -9,6 +9,7 @@
 //                    reused across iterations and redone only when the line search fails, when the direction is
 //                    not a descent direction, or when max|g| has not halved in `refactor_stall` iterations.
 //                    Its first step is a (projected) Newton step; later steps are quasi-Newton corrections of it.
+#include <memory>
 #include <string>
 
 #include "fibernet/solve/line_search.hpp"
@@ -38,6 +39,8 @@ public:
     std::string name() const override { return p_.hessian_h0 ? "lbfgs-hessian" : "lbfgs"; }
     SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
+    SolverCapabilities capabilities() const override;
+    std::unique_ptr<Solver> clone() const override { return std::make_unique<LbfgsSolver>(opt_, p_); }
 
 private:
     SolverOptions opt_;

@@ -12,6 +12,7 @@
 // The returned point is the lowest energy NLopt evaluated. SolverOptions::max_iter bounds evaluations
 // (NLopt counts no iterations); max_seconds maps to maxtime and is also checked at every evaluation, since NLopt
 // checks maxtime only between its outer iterations (TNEWTON overran a 4 s budget to 31 s without this).
+#include <memory>
 #include <string>
 
 #include "fibernet/solve/solver.hpp"
@@ -34,6 +35,8 @@ public:
     std::string name() const override;
     SolverOptions& options() override { return opt_; }
     SolveResult minimize(Objective& f, Eigen::VectorXd& q) override;
+    SolverCapabilities capabilities() const override { return {}; }
+    std::unique_ptr<Solver> clone() const override { return std::make_unique<NloptSolver>(method_, opt_, p_); }
 
 private:
     NloptMethod method_;

@@ -1,10 +1,13 @@
 #pragma once
-// A minimizer of an Objective: it sees only value, gradient and Hessian. Every solver in solve/ implements this and
-// is created by name (make_solver) so that `--solver` can pick any of them.
+// A minimizer of an Objective: it sees only value, gradient and Hessian. Every solver in solve/ implements this, runs
+// its iterations in the one loop of solver_loop.hpp, and is created by name from the registry (solver_registry.hpp),
+// so that `--solver` can pick any of them. Callers ask a solver what it can do (capabilities()) and copy it (clone()),
+// never which one it is.
 #include <memory>
 #include <string>
 
 #include "fibernet/energy/objective.hpp"
+#include "fibernet/solve/linear_solver.hpp"
 #include "fibernet/solve/nonlinear_elimination.hpp"
 #include "fibernet/solve/result.hpp"
 
@@ -22,6 +25,21 @@ struct SolverOptions {
     bool eliminate = false;  // Newton: nonlinear elimination of the hot places before and inside each global step
                              // (nonlinear_elimination.hpp); others ignore it
     EliminationOptions elimination;
+
+    // The one check of these options (every solver's constructor calls it): throws InputError("<where>: <name> = <v>
+    // must ..."), `where` naming the solver.
+    void check(const std::string& where) const;
+};
+
+// What a solver does with the options and the objective, for callers that adapt to it.
+struct SolverCapabilities {
+    bool hessian = false;       // assembles the sparse Hessian
+    bool ldl = false;           // SolverOptions::ldl acts
+    bool eliminate = false;     // SolverOptions::eliminate acts
+    bool warm_start = false;    // SolverOptions::warm_start acts
+    bool newton_steps = false;  // an iteration is a factorized Newton step, so a few of them make a round of the wet
+                                // active-set loop and its local rounds are solved with it (docs/wet.md, "Local rounds")
+    bool shares_factorization = false;  // factorization_for() offers its analyzed positive definite factorization
 };
 
 class Solver {
@@ -34,9 +52,21 @@ public:
     // The options the next minimize() uses; a caller may change them between calls (the wet active-set loop caps
     // the iterations of a round while its bridge set is still changing).
     virtual SolverOptions& options() = 0;
+    virtual SolverCapabilities capabilities() const = 0;
+    // A solver of the same kind, options and parameters, without what earlier minimize() calls adapted (shifts,
+    // analyses): for a caller that needs another one (a thread's, a corrector's).
+    virtual std::unique_ptr<Solver> clone() const = 0;
+    // With capabilities().shares_factorization: the positive definite factorization this solver factors with,
+    // analyzed for `pattern` (re-analyzed only if the pattern changed), for a caller that solves with the same
+    // Hessian afterwards (the linear moduli at an equilibrium); else nullptr.
+    virtual LinearSolver* factorization_for(const Eigen::SparseMatrix<double>& pattern) {
+        (void)pattern;
+        return nullptr;
+    }
 };
 
-// Throws InputError naming the solver if unknown.
+// The solver registered as `name` (solver_registry.hpp) with options `opt`; throws InputError naming an unknown
+// solver or a bad option.
 std::unique_ptr<Solver> make_solver(const std::string& name, const SolverOptions& opt);
 
 }  // namespace fibernet

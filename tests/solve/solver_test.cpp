@@ -9,28 +9,28 @@
 #include "fibernet/solve/lbfgs.hpp"
 #include "fibernet/solve/line_search.hpp"
 #include "fibernet/solve/nlopt_solver.hpp"
-#include "fibernet/solve/solver_suite.hpp"
+#include "fibernet/solve/solver_registry.hpp"
 #include "fibernet/util/error.hpp"
 
 using namespace fibernet;
 using Catch::Matchers::Contains;
 
-TEST_CASE("bad SolverOptions are refused by every suite solver, naming the value", "[solve][options]") {
+TEST_CASE("bad SolverOptions are refused by every solver, naming the value", "[solve][options]") {
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    for (const auto& name : suite_solver_names()) {
+    for (const auto& name : solver_names()) {
         INFO(name);
         SolverOptions o;
         o.tol = 0;
-        CHECK_THROWS_WITH(make_suite_solver(name, o), Contains(name) && Contains("tol = 0"));
+        CHECK_THROWS_WITH(make_solver(name, o), Contains(name) && Contains("tol = 0"));
         o.tol = nan;
-        CHECK_THROWS_AS(make_suite_solver(name, o), InputError);
+        CHECK_THROWS_AS(make_solver(name, o), InputError);
         o = SolverOptions{};
         o.max_iter = 0;
-        CHECK_THROWS_WITH(make_suite_solver(name, o), Contains("max_iter = 0"));
+        CHECK_THROWS_WITH(make_solver(name, o), Contains("max_iter = 0"));
         o = SolverOptions{};
         o.max_seconds = -1;
-        CHECK_THROWS_WITH(make_suite_solver(name, o), Contains("max_seconds = -1"));
-        CHECK_NOTHROW(make_suite_solver(name, SolverOptions{}));
+        CHECK_THROWS_WITH(make_solver(name, o), Contains("max_seconds = -1"));
+        CHECK_NOTHROW(make_solver(name, SolverOptions{}));
     }
 }
 

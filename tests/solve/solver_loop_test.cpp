@@ -1,0 +1,186 @@
+// The solver loop (solver_loop.hpp): the stop tests, the iteration and evaluation counts, the finish, and the fresh
+// evaluation that decides a backend's status, with a scripted method on a quadratic whose state is known exactly.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+#include "fibernet/solve/solver_loop.hpp"
+#include "fibernet/util/error.hpp"
+
+using namespace fibernet;
+
+namespace {
+// f = 1/2 |x|^2 (g = x), with a Hessian pattern of its diagonal.
+class Quadratic : public Objective {
+public:
+    explicit Quadratic(int n) : P_(n, n) {
+        for (int i = 0; i < n; ++i) P_.insert(i, i) = 0;
+        P_.makeCompressed();
+    }
+    int size() const override { return static_cast<int>(P_.rows()); }
+    double value(const Eigen::VectorXd& q) override { return 0.5 * q.squaredNorm(); }
+    double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override {
+        g = q;
+        return value(q);
+    }
+    double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool) override {
+        H = P_;
+        for (int i = 0; i < size(); ++i) H.coeffRef(i, i) = 1;
+        return gradient(q, g);
+    }
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return P_; }
+
+private:
+    Eigen::SparseMatrix<double> P_;
+};
+
+// Halves q every iteration; every `idle`-th iteration does not move (Step::again); stops with `stop_status` at
+// iteration `stop_at` (moved or not, as `stop_moves` says).
+class Halving : public IterativeMethod {
+public:
+    int idle = 0, stop_at = -1;
+    bool stop_moves = false;
+    SolveStatus stop_status = SolveStatus::Stalled;
+    int calls = 0;
+    double sleep = 0;
+
+    Step start(SolverRun& run, Eigen::VectorXd& q) override {
+        e_ = run.objective().gradient(q, g_);
+        return Step::again();
+    }
+    Step iterate(SolverRun& run, Eigen::VectorXd& q, int k) override {
+        ++calls;
+        if (sleep > 0) std::this_thread::sleep_for(std::chrono::duration<double>(sleep));
+        if (k == stop_at && !stop_moves) return Step::stop(stop_status, "scripted stop");
+        if (idle > 0 && calls % idle == 0) return Step::again();
+        q *= 0.5;
+        e_ = run.objective().gradient(q, g_);
+        if (k == stop_at) return Step::stop(stop_status, "scripted stop after a move", true);
+        return Step::moved();
+    }
+    double energy() const override { return e_; }
+    double grad_max() const override { return g_.lpNorm<Eigen::Infinity>(); }
+    void complete(SolveResult& r, const Step& last, const Eigen::VectorXd&) override {
+        completed = last.done;
+        r.local_solves = 7;  // a method's own field, kept by the finish
+    }
+    bool completed = false;
+
+private:
+    double e_ = 0;
+    Eigen::VectorXd g_;
+};
+}  // namespace
+
+TEST_CASE("solver loop: converges at max|g| <= tol, counting only the iterations that moved", "[solve][loop]") {
+    Quadratic f(3);
+    SolverOptions o;
+    o.tol = 1e-3;
+    Halving m;
+    m.idle = 3;  // every third call does not move
+    Eigen::VectorXd q = Eigen::VectorXd::Constant(3, 1.0);
+    SolverRun run("halving", o, f, q);
+    const SolveResult r = run_iterations(run, m, q);
+    CHECK(r.status == SolveStatus::Converged);
+    CHECK(r.solver == "halving");
+    // 1 -> 2^-10 < 1e-3 takes 10 moves; the idle calls are not iterations.
+    CHECK(r.iterations == 10);
+    CHECK(m.calls == 14);  // calls 3, 6, 9 and 12 were idle
+    CHECK(q[0] == std::ldexp(1.0, -10));
+    CHECK(r.grad_max == std::ldexp(1.0, -10));
+    CHECK(r.energy == 1.5 * std::ldexp(1.0, -20));
+    CHECK(r.evaluations == 1 + 10);  // the start and one per move, counted by the run's objective
+    CHECK(m.completed);
+    CHECK(r.local_solves == 7);
+    CHECK(r.timings.total >= 0);
+}
+
+TEST_CASE("solver loop: the iteration budget and the time budget end a solve, named", "[solve][loop]") {
+    Quadratic f(2);
+    SolverOptions o;
+    o.tol = 1e-12;
+    o.max_iter = 5;
+    Halving m;
+    Eigen::VectorXd q = Eigen::VectorXd::Ones(2);
+    SolverRun run("halving", o, f, q);
+    SolveResult r = run_iterations(run, m, q);
+    CHECK(r.status == SolveStatus::IterationLimit);
+    CHECK(r.iterations == 5);
+    CHECK(r.message.find("iteration limit 5") != std::string::npos);
+    CHECK(!r.converged());
+
+    o.max_iter = 1000000, o.max_seconds = 0.05;
+    Halving slow;
+    slow.sleep = 0.02;
+    q = Eigen::VectorXd::Ones(2);
+    SolverRun timed("halving", o, f, q);
+    r = run_iterations(timed, slow, q);
+    CHECK(r.status == SolveStatus::IterationLimit);
+    CHECK(r.message == "time limit reached");
+    CHECK(r.iterations >= 1);
+    CHECK(r.iterations < 1000);
+    CHECK(r.timings.total >= 0.05);
+}
+
+TEST_CASE("solver loop: a method's stop ends the solve, counting the move it made", "[solve][loop]") {
+    Quadratic f(2);
+    SolverOptions o;
+    o.tol = 1e-12;
+    for (bool moves : {false, true}) {
+        Halving m;
+        m.stop_at = 4, m.stop_moves = moves;
+        Eigen::VectorXd q = Eigen::VectorXd::Ones(2);
+        SolverRun run("halving", o, f, q);
+        const SolveResult r = run_iterations(run, m, q);
+        CHECK(r.status == SolveStatus::Stalled);
+        CHECK(r.iterations == (moves ? 5 : 4));
+        CHECK(q[0] == std::ldexp(1.0, moves ? -5 : -4));
+    }
+}
+
+TEST_CASE("solver loop: a start of the wrong size is refused, naming both sizes", "[solve][loop]") {
+    Quadratic f(3);
+    const Eigen::VectorXd q = Eigen::VectorXd::Ones(2);
+    CHECK_THROWS_AS(SolverRun("halving", SolverOptions{}, f, q), InputError);
+    CHECK_THROWS_WITH(SolverRun("halving", SolverOptions{}, f, q),
+                      Catch::Matchers::Contains("2 entries") && Catch::Matchers::Contains("3"));
+}
+
+TEST_CASE("solver loop: finish_verified decides the status from the returned state", "[solve][loop]") {
+    Quadratic f(2);
+    SolverOptions o;
+    o.tol = 1e-6;
+    Eigen::VectorXd q = Eigen::VectorXd::Constant(2, 1e-3);  // max|g| = 1e-3 > tol
+    {
+        SolverRun run("backend", o, f, q);
+        const SolveResult r = run.finish_verified(SolveStatus::Converged, "backend says so", q, SolveStatus::Stalled);
+        CHECK(r.status == SolveStatus::Stalled);  // a claim above tol is not taken
+        CHECK(r.grad_max == 1e-3);
+        CHECK(r.evaluations == 1);
+    }
+    q.setConstant(1e-8);
+    {
+        SolverRun run("backend", o, f, q);
+        const SolveResult r = run.finish_verified(SolveStatus::Failed, "backend gave up", q, SolveStatus::Stalled);
+        CHECK(r.status == SolveStatus::Converged);  // the state is an equilibrium whatever the backend said
+    }
+    q[0] = std::numeric_limits<double>::quiet_NaN();
+    {
+        SolverRun run("backend", o, f, q);
+        const SolveResult r = run.finish_verified(SolveStatus::Converged, "backend says so", q, SolveStatus::Stalled);
+        CHECK(r.status == SolveStatus::NonFinite);
+    }
+}
+
+TEST_CASE("solver loop: the counted objective forwards the restriction uncounted", "[solve][loop]") {
+    Quadratic f(2);
+    CountedObjective c(f);
+    Eigen::VectorXd q = Eigen::VectorXd::Ones(2), g;
+    c.value(q), c.gradient(q, g);
+    Eigen::SparseMatrix<double> H = c.hessian_pattern();
+    c.hessian(q, g, H, false);
+    CHECK(c.evaluations == 3);
+    CHECK(c.restriction(q, {0}) == nullptr);  // Quadratic offers none
+    CHECK(c.evaluations == 3);
+}
