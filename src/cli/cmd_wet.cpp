@@ -279,6 +279,7 @@ void register_wet(CLI::App& app) {
         opt.rule.fraction = s.wet.fraction, opt.rule.seed = s.wet.seed;
         opt.solver = s.solver.name;
         opt.solver_options.tol = s.solver.tol, opt.solver_options.max_iter = s.solver.max_iter;
+        opt.solver_options.eliminate = s.solver.eliminate;
         opt.solver_options.verbose = w->verbose;
         opt.active_set.verbose = w->verbose || !w->quiet;
         opt.active_set.max_rounds = s.wet.max_rounds;
@@ -368,7 +369,8 @@ void register_wet(CLI::App& app) {
                                 {"wet", wet_settings},
                                 {"strain", to_string(s.strain)},
                                 {"gamma", s.gamma},
-                                {"solver", {{"name", s.solver.name}, {"tol", s.solver.tol}, {"max_iter", s.solver.max_iter}}},
+                                {"solver", {{"name", s.solver.name}, {"tol", s.solver.tol}, {"max_iter", s.solver.max_iter},
+                                            {"eliminate", s.solver.eliminate}}},
                                 {"runs", runs},
                                 {"complete", complete},
                                 {"seconds", seconds_since(t_all)}};

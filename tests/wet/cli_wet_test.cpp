@@ -277,7 +277,7 @@ TEST_CASE("cli wet: summary.json records what reproduces the run", "[wet][cli]")
     CHECK(w["law_table"] == law_text);  // the table itself: the file may change or be gone
     CHECK(w["law_fnv1a"].is_number_unsigned());
     CHECK(w["moduli"] == false);
-    CHECK(j["solver"] == nlohmann::json({{"name", "newton"}, {"tol", 1e-10}, {"max_iter", 500}}));
+    CHECK(j["solver"] == nlohmann::json({{"name", "newton"}, {"tol", 1e-10}, {"max_iter", 500}, {"eliminate", false}}));
     CHECK(j["prune"] == nlohmann::json::array());
     CHECK(j["parameters"]["seed"] == 3);
     // The default law is named, with no table.

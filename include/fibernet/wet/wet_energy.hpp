@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "fibernet/energy/capillary.hpp"
@@ -38,6 +39,11 @@ public:
     double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override;
     double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool project_psd) override;
     const Eigen::SparseMatrix<double>& hessian_pattern() const override;
+    // The energy of the coordinates `coords` alone (Objective::restriction; nonlinear elimination): a WetRegion
+    // (wet_region.hpp) over their nodes, at the cost of the nodes' elements. nullptr when some node has only one of
+    // its two free coordinates in the set (the caller then restricts through value/gradient/Hessian).
+    // wet_restriction.cpp.
+    std::unique_ptr<Objective> restriction(const Eigen::VectorXd& q, const std::vector<int>& coords) override;
 
     WetSplit split(const Eigen::VectorXd& q) const;
     // Each bridge's own energy at q (for reports and the continuity test).
@@ -67,6 +73,9 @@ public:
     // the dry terms to run beside the first chunk on a 1e4-fiber network). Results do not depend on it.
     void set_chunk(size_t elements) { chunk_ = elements < 1 ? 1 : elements; }
 
+    // What restriction() builds once per energy: the element incidence of every node and each coordinate's node.
+    struct RestrictionData;
+
 private:
     double eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd);
     bool active() const { return params_.beta != 0 && !bridges_.empty(); }
@@ -79,6 +88,7 @@ private:
     std::uint64_t id_;
     // Built on first use (hessian_pattern()); not thread safe (one WetEnergy per solve).
     mutable bool pattern_built_ = false;
+    std::shared_ptr<RestrictionData> restriction_;  // built on the first restriction()
     mutable Eigen::SparseMatrix<double> pattern_, dry_H_;
     mutable std::vector<int> dry_slot_;     // dry pattern value index -> union value index
     mutable std::vector<int> bridge_slots_; // 256 per bridge: union value index of local (a, b) with row <= col, else -1
