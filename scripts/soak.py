@@ -3,7 +3,8 @@
 
 One case is one random network (L uniform in (2, 5], q in [4, 12], pl in [0.3, 1], scheme seed|even, periodic or
 --open, a random seed), run through every command of --commands (default modulus,sweep,wet), one process at a time;
---every wet=K runs a command only on every K-th case, --round-robin runs case i through one command only (command
+--every wet=K runs a command only on every K-th case, --flags CMD=FLAGS adds flags to a command (e.g.
+modulus=--eliminate), --round-robin runs case i through one command only (command
 i mod the number of commands). Commands:
 
   modulus  fibernet modulus NET -q [--gamma 0.01 on one case in five]
@@ -305,6 +306,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "fibernet-soak-failures"),
                     help="directory for failing reproducers (default %(default)s)")
     ap.add_argument("--commands", default=",".join(COMMANDS), help="comma-separated subset of modulus,sweep,wet")
+    ap.add_argument("--flags", action="append", default=[], metavar="CMD=FLAGS",
+                    help="extra flags for a command, e.g. modulus=--eliminate (space-separated; repeatable)")
     ap.add_argument("--round-robin", action="store_true", help="case i runs only command i mod len(commands)")
     ap.add_argument("--every", action="append", default=[], metavar="CMD=K",
                     help="run CMD only on every K-th case (e.g. wet=3); repeatable")
@@ -329,6 +332,12 @@ def main():
         if not m or m.group(1) not in COMMANDS or int(m.group(2)) < 1:
             ap.error("--every %r: expected CMD=K with K >= 1" % e)
         every[m.group(1)] = int(m.group(2))
+    extra = {}
+    for e in a.flags:
+        cmd, _, flags = e.partition("=")
+        if cmd not in COMMANDS or not flags.strip():
+            ap.error("--flags %r: expected CMD=FLAGS with CMD one of %s" % (e, ",".join(COMMANDS)))
+        extra.setdefault(cmd, []).extend(flags.split())
     fib = os.path.abspath(a.fibernet)
     if not os.access(fib, os.X_OK):
         ap.error("--fibernet %s is not an executable" % fib)
@@ -355,7 +364,7 @@ def main():
                 if os.path.exists(d):
                     shutil.rmtree(d)
                 os.makedirs(d)
-                argv = argv_for(cmd, net, rng, d)
+                argv = argv_for(cmd, net, rng, d) + extra.get(cmd, [])
                 if cmd == "wet":
                     r = run([fib] + argv, d, a.wet_timeout, a.stall)
                 else:

@@ -165,6 +165,12 @@ Eigen::VectorXd NetworkEnergy::displacements(const Eigen::VectorXd& q, const Eig
     return u;
 }
 
+void NetworkEnergy::displacement_of(int i, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
+                                    Eigen::VectorXd& u) const {
+    if (dof_[2 * i] >= 0) u[2 * i] = q[dof_[2 * i]], u[2 * i + 1] = q[dof_[2 * i + 1]];
+    else u.segment<2>(2 * i) = (F - Eigen::Matrix2d::Identity()) * model_.x.segment<2>(2 * i);
+}
+
 double NetworkEnergy::segment_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F, Eigen::Vector4d* g,
                                    Eigen::Matrix4d* H, bool psd) const {
     const Segment& s = model_.segments[e];

@@ -48,7 +48,7 @@ NodeElements node_elements(const NetworkEnergy& e) {
 
 NetworkRegion::NetworkRegion(const NetworkEnergy& e, const Eigen::Matrix2d& F, const NodeElements& inc,
                              const Eigen::VectorXd& q, const std::vector<int>& coords)
-    : e_(e), F_(F), coords_(coords), u_(e.displacements(q, F)) {
+    : e_(e), F_(F), coords_(coords) {
     const Model& m = e.model();
     std::vector<int> nodes;
     for (int c : coords_) {
@@ -72,6 +72,14 @@ NetworkRegion::NetworkRegion(const NetworkEnergy& e, const Eigen::Matrix2d& F, c
     for (int h : hinges_)
         for (int v : {m.hinges[h].i, m.hinges[h].j, m.hinges[h].k})
             for (int c = 0; c < 2; ++c) hinge_idx_.push_back(local(v, c));
+    // The displacements of the elements' nodes only: the elements read no other entry, so the rest of u_ is left
+    // unwritten (its pages never touched), and a region costs its elements, not a copy of the network (at L = 80 a
+    // copy of 1.4e6 entries per part and line-search trial).
+    u_.resize(2 * m.num_nodes());
+    for (int s : segs_)
+        for (int v : {m.segments[s].i, m.segments[s].j}) e.displacement_of(v, q, F, u_);
+    for (int h : hinges_)
+        for (int v : {m.hinges[h].i, m.hinges[h].j, m.hinges[h].k}) e.displacement_of(v, q, F, u_);
     PatternBuilder builder(size());
     builder.add_elements(seg_idx_, 4), builder.add_elements(hinge_idx_, 6);
     builder.add_diagonal();

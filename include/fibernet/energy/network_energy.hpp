@@ -77,6 +77,8 @@ public:
     // displacement from displacements(q, F) (fixed nodes at (F - I) x_ref). Local coordinates are the element's
     // nodes' (x, y) in order: segment (i, j), hinge (i, j, k). Same terms as evaluate().
     Eigen::VectorXd displacements(const Eigen::VectorXd& q, const Eigen::Matrix2d& F) const;
+    // Node i's entries of displacements(q, F) written into u (a region's elements read only their own nodes').
+    void displacement_of(int i, const Eigen::VectorXd& q, const Eigen::Matrix2d& F, Eigen::VectorXd& u) const;
     double segment_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F, Eigen::Vector4d* g,
                         Eigen::Matrix4d* H, bool project_psd) const;
     double hinge_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F, Eigen::Matrix<double, 6, 1>* g,

@@ -43,7 +43,8 @@ private:
     const NetworkEnergy& e_;
     Eigen::Matrix2d F_;
     std::vector<int> coords_, coord_u_;  // region coordinate -> coordinate of q, and its entry of u_
-    Eigen::VectorXd u_;                  // every node's displacement; an evaluation rewrites the region's entries
+    Eigen::VectorXd u_;                  // the elements' nodes' displacements (other entries unset); an evaluation
+                                         // rewrites the region's entries
     std::vector<int> segs_, hinges_;     // elements with a node in the region
     std::vector<int> seg_idx_, hinge_idx_;    // per element and local coordinate: region index or -1 (held)
     std::vector<int> seg_slot_, hinge_slot_;  // per element: value slot of each local pair (a, b), -1 if none
