@@ -37,6 +37,7 @@
 // (DiscretizationParams::trim_ends); all exact for dry equilibria, so every solver sees a smaller, same problem.
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -66,6 +67,24 @@
 using namespace fibernet;
 
 namespace {
+
+// A solver by registry name, or "newton+eliminate": Newton with nonlinear elimination (`--eliminate`), charted beside
+// plain Newton.
+const char* const kEliminate = "+eliminate";
+std::unique_ptr<Solver> bench_solver(const std::string& spec, SolverOptions opt) {
+    const size_t k = spec.size() > std::strlen(kEliminate) ? spec.size() - std::strlen(kEliminate) : 0;
+    if (k > 0 && spec.compare(k, std::string::npos, kEliminate) == 0) {
+        opt.eliminate = true;
+        return make_solver(spec.substr(0, k), opt);
+    }
+    return make_solver(spec, opt);
+}
+// Every registered solver, with newton+eliminate after newton.
+std::vector<std::string> bench_solver_names() {
+    std::vector<std::string> names = solver_names();
+    names.insert(names.begin() + 1, std::string("newton") + kEliminate);
+    return names;
+}
 
 std::vector<std::string> split(const std::string& s) {
     std::vector<std::string> out;
@@ -106,6 +125,10 @@ public:
         return e;
     }
     const Eigen::SparseMatrix<double>& hessian_pattern() const override { return f_.hessian_pattern(); }
+    // Nonlinear elimination's parts: their evaluations are of a part's energy, not recorded.
+    std::unique_ptr<Objective> restriction(const Eigen::VectorXd& q, const std::vector<int>& coords) override {
+        return f_.restriction(q, coords);
+    }
     std::vector<Sample> samples;
 
 private:
@@ -457,7 +480,7 @@ int main(int argc, char** argv) {
             G.verbose = arg["verbose"] == "1", G.out = arg["out"];
             G.solvers = split(arg["solvers"]);
             if (G.solvers.empty()) G.solvers = solver_names();
-            for (const auto& n : G.solvers) make_solver(n, SolverOptions{});  // an unknown name fails here
+            for (const auto& n : G.solvers) bench_solver(n, SolverOptions{});  // an unknown name fails here
             for (const auto& sc : G.schemes) parse_scheme(sc);
             if (G.Ls.empty() || G.qs.empty() || G.as.empty() || G.gammas.empty() || G.betas.empty() ||
                 G.schemes.empty())
@@ -486,7 +509,8 @@ int main(int argc, char** argv) {
         return stability_wet(G);
     }
     std::vector<std::string> solvers = split(arg["solvers"]);
-    if (solvers.empty()) solvers = solver_names();
+    if (solvers.empty()) solvers = bench_solver_names();
+    for (const auto& n : solvers) bench_solver(n, SolverOptions{});  // an unknown name fails here
     const std::string mode = arg["mode"], out = arg["out"];
     const double tol_abs = std::stod(arg["tol"]), rel_tol = std::stod(arg["rel-tol"]);
     const int max_iter = std::stoi(arg["max-iter"]);
@@ -587,7 +611,7 @@ int main(int argc, char** argv) {
                                 SolverOptions opt;
                                 opt.tol = k == 0 ? tol_abs : target, opt.max_iter = max_iter, opt.verbose = verbose;
                                 opt.max_seconds = k == 0 ? ref_budget : budget;
-                                auto solver = make_solver(names[k], opt);
+                                auto solver = bench_solver(names[k], opt);
                                 StrainedEnergy obj(energy, F);
                                 Recorder rec(obj);
                                 Eigen::VectorXd x = q0;
@@ -704,7 +728,7 @@ int main(int argc, char** argv) {
         for (const auto& name : solvers) {
             SolverOptions opt;
             opt.tol = tol, opt.max_iter = max_iter, opt.max_seconds = budget, opt.verbose = verbose;
-            auto solver = make_solver(name, opt);
+            auto solver = bench_solver(name, opt);
             StrainedEnergy obj(energy, F);
             Recorder rec(obj);
             Eigen::VectorXd q = q0;

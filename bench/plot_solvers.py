@@ -17,9 +17,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ORDER = ["newton", "lbfgs-hessian", "ipopt", "lbfgs", "nlopt-lbfgs", "nlopt-var2", "nlopt-tnewton", "cg", "fire"]
+ORDER = ["newton", "newton+eliminate", "lbfgs-hessian", "ipopt", "lbfgs", "nlopt-lbfgs", "nlopt-var2",
+         "nlopt-tnewton", "cg", "fire"]
 STYLE = {
-    "newton": ("k", "-"), "lbfgs-hessian": ("tab:blue", "-"), "ipopt": ("tab:purple", "-"),
+    "newton": ("k", "-"), "newton+eliminate": ("k", "--"), "lbfgs-hessian": ("tab:blue", "-"),
+    "ipopt": ("tab:purple", "-"),
     "lbfgs": ("tab:orange", "-"), "nlopt-lbfgs": ("tab:orange", "--"), "nlopt-var2": ("tab:brown", "--"),
     "nlopt-tnewton": ("tab:pink", "--"), "cg": ("tab:green", "-"), "fire": ("tab:red", "-"),
 }
@@ -68,7 +70,7 @@ def main():
                 axes[row][col].grid(True, which="major", alpha=0.3)
         axes[0][0].set_ylabel("running min of max|g|")
         axes[1][0].set_ylabel("running min of (E - E_best) / |E_best|")
-        fig.legend(loc="lower center", ncol=len(ORDER), fontsize=9, frameon=False)
+        fig.legend(loc="lower center", ncol=(len(ORDER) + 1) // 2, fontsize=9, frameon=False)
         fig.suptitle(f"Work-precision, simple shear gamma = 0.05 (o: converged, x: stopped otherwise; dotted: tol)",
                      fontsize=11)
         fig.tight_layout(rect=(0, 0.04, 1, 0.97))

@@ -22,7 +22,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 
-ORDER = ["newton", "lbfgs-hessian", "ipopt", "lbfgs", "nlopt-lbfgs", "nlopt-var2", "nlopt-tnewton", "cg", "fire"]
+ORDER = ["newton", "newton+eliminate", "lbfgs-hessian", "ipopt", "lbfgs", "nlopt-lbfgs", "nlopt-var2",
+         "nlopt-tnewton", "cg", "fire"]
 CODE = {"converged": "ok", "iteration_limit": "budget", "line_search_failed": "LS-fail", "stalled": "stalled",
         "non_finite": "non-finite", "failed": "failed"}
 COLOUR = {"converged": 0, "iteration_limit": 1, "stalled": 2, "line_search_failed": 3, "failed": 4, "non_finite": 5}

@@ -158,12 +158,19 @@ private:
         return Step::stop(SolveStatus::Converged, buf, it > 0);
     }
 
+    // What is left of the time budget for the local solves (0: no budget; a spent one leaves a tiny positive rest,
+    // so that no part is solved and the loop's stop test ends the solve).
+    double time_left(const SolverRun& run) const {
+        if (opt_.max_seconds <= 0) return 0;
+        return std::max(opt_.max_seconds - run.seconds(), 1e-9);
+    }
+
     // Nonlinear elimination (nonlinear_elimination.hpp): the hot places to local equilibrium, then H and g again.
     Step eliminate(SolverRun& run, Eigen::VectorXd& q, int it) {
         eliminating_ = false;
         if (!ne_ || !ne_->select(g_)) return Step::again();
         local_tol_ = std::max(opt_.tol, opt_.elimination.local_rtol * gmax_);
-        ne_->eliminate(run.objective(), q, local_tol_);
+        ne_->eliminate(run.objective(), q, local_tol_, time_left(run));
         eliminating_ = true;
         const auto ta = Clock::now();
         fq_ = run.objective().hessian(q, g_, H_, projected_);
@@ -234,7 +241,7 @@ private:
             alpha = 1;
             for (int k = 0; k < kMaxHalvings; ++k, alpha *= 0.5) {
                 qt_ = q + alpha * d_;
-                if (eliminating_) ne_->eliminate(f, qt_, local_tol_);
+                if (eliminating_) ne_->eliminate(f, qt_, local_tol_, time_left(run));
                 ft = f.value(qt_);
                 if (!std::isfinite(ft)) continue;
                 if (ft <= fq_ + kArmijo * alpha * gd) return true;

@@ -78,11 +78,16 @@ bool NonlinearElimination::select(const Eigen::VectorXd& g) {
     return true;
 }
 
-void NonlinearElimination::eliminate(Objective& f, Eigen::VectorXd& q, double tol) {
+void NonlinearElimination::eliminate(Objective& f, Eigen::VectorXd& q, double tol, double max_seconds) {
     const auto t0 = std::chrono::steady_clock::now();
     SolverOptions o;
     o.tol = tol, o.max_iter = opt_.local_max_iter;
     for (const std::vector<int>& part : parts_) {
+        if (max_seconds > 0) {
+            const double left = max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            if (left <= 0) break;
+            o.max_seconds = left;
+        }
         std::unique_ptr<Objective> sub = f.restriction(q, part);
         if (!sub) sub = std::make_unique<SubsetObjective>(f, q, part);
         Eigen::VectorXd qa(part.size());

@@ -172,3 +172,32 @@ TEST_CASE("elimination selects connected parts of the hot coordinates grown thro
     CHECK_FALSE(capped.select(g));
     CHECK_FALSE(ne.select(Eigen::VectorXd::Zero(n)));
 }
+
+TEST_CASE("elimination's local solves share the caller's time budget", "[solve][elimination]") {
+    Sheared s;
+    StrainedEnergy f(*s.e, s.F);
+    Eigen::VectorXd q = affine_start(*s.e, s.F), g;
+    f.gradient(q, g);
+    EliminationOptions eo;
+    eo.hops = 1, eo.max_fraction = 1;  // places small enough to be selected at the affine start
+    NonlinearElimination ne(f.hessian_pattern(), eo);
+    REQUIRE(ne.select(g));
+    // A budget spent before the first part: no part moves (none is solved, or its solve stops at its first time test).
+    Eigen::VectorXd q1 = q;
+    ne.eliminate(f, q1, 1e-10, 1e-300);
+    CHECK(q1 == q);
+    // No budget: every part is solved, and the energy does not rise.
+    const int before = ne.counts().local_solves;
+    Eigen::VectorXd q2 = q;
+    ne.eliminate(f, q2, 1e-10, 0);
+    CHECK(ne.counts().local_solves - before == static_cast<int>(ne.parts().size()));
+    CHECK(q2 != q);
+    CHECK(f.value(q2) <= f.value(q));
+    // Newton with elimination and a spent budget stops at the loop's time test, saying so.
+    SolverOptions o;
+    o.eliminate = true, o.max_seconds = 1e-9;
+    Eigen::VectorXd q3 = q;
+    const SolveResult r = NewtonSolver(o).minimize(f, q3);
+    CHECK(r.status == SolveStatus::IterationLimit);
+    CHECK(r.message == "time limit reached");
+}

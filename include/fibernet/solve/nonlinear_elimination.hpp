@@ -53,7 +53,9 @@ public:
     int coordinates() const { return selected_; }
 
     // Minimizes f over each part in turn, the others held, overwriting q's entries of the parts; never raises f.
-    void eliminate(Objective& f, Eigen::VectorXd& q, double tol);
+    // max_seconds > 0: the parts' solves share this wall-time budget (the caller's remaining one); parts not reached
+    // in it are left as they are.
+    void eliminate(Objective& f, Eigen::VectorXd& q, double tol, double max_seconds = 0);
 
     const EliminationCounts& counts() const { return counts_; }
 
