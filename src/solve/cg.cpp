@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include "fibernet/solve/solver_loop.hpp"
 #include "solver_util.hpp"
 
 namespace fibernet {
@@ -36,7 +35,7 @@ public:
         if (!std::isfinite(fx_) || !g_.allFinite())
             return Step::stop(SolveStatus::NonFinite, "non-finite energy or gradient at the start");
         f_scale_ = std::abs(fx_);  // energy scale for the line search's round-off allowance
-        gmax_best_ = gmax_;
+        watch_.start(gmax_);
         d_ = -g_;
         alpha0_ = 1.0 / std::max(g_.norm(), 1e-300);
         return Step::again();
@@ -52,28 +51,17 @@ public:
                 alpha0_ = 1.0 / std::max(g_.norm(), 1e-300);
                 return Step::again();
             }
-            const SolveStatus st =
-                lr.outcome == LineSearchOutcome::NonFinite ? SolveStatus::NonFinite : SolveStatus::LineSearchFailed;
-            return Step::stop(st, "line search: " + to_string(lr.outcome) + " after " + std::to_string(lr.evals) +
-                                      " evaluations at max|g| = " + show(gmax_));
+            return detail::line_search_stop(lr, gmax_);
         }
         ++since_restart_;
-        // Progress: an energy decrease beyond round-off, or a new lowest max|g| (below round-off the energy
-        // cannot tell, the gradient still can). A gradient inconsistent with the energy shows neither.
-        const double gn_max = detail::max_abs(gn_);
-        const double noise = 1e-16 * std::abs(fx_);  // any decrease beyond the last bits
-        const bool progress = lr.f < fx_ - noise || gn_max < 0.9 * gmax_best_;
-        gmax_best_ = std::min(gmax_best_, gn_max);
-        no_decrease_ = progress ? 0 : no_decrease_ + 1;
+        watch_.update(fx_, lr.f, detail::max_abs(gn_));
         const double gd_old = g_.dot(d_);
         double beta = std::max(0.0, gn_.dot(gn_ - g_) / g_.squaredNorm());
         if (since_restart_ >= restart_) beta = 0, since_restart_ = 0;
         q.swap(xn_), g_.swap(gn_), fx_ = lr.f, gmax_ = detail::max_abs(g_);
         if (gmax_ <= run.options().tol) return Step::moved();
-        if (no_decrease_ >= p_.stall_iterations)
-            return Step::stop(SolveStatus::Stalled, "no energy decrease beyond round-off and no new minimum of max|g| for " +
-                                                        std::to_string(no_decrease_) + " iterations at max|g| = " +
-                                                        show(gmax_), true);
+        Step stop;
+        if (watch_.stalled(p_.stall_iterations, gmax_, stop)) return stop;
         d_ = -g_ + beta * d_;
         steepest_ = beta == 0;
         if (!(g_.dot(d_) < 0)) d_ = -g_, steepest_ = true, since_restart_ = 0;
@@ -90,9 +78,10 @@ private:
     const CgParams p_;
     const StrongWolfeLineSearch ls_;
     VectorXd g_, d_, xn_, gn_;
-    int restart_ = 1, no_decrease_ = 0, since_restart_ = 0;
+    detail::StallWatch watch_;
+    int restart_ = 1, since_restart_ = 0;
     bool steepest_ = true;
-    double fx_ = 0, gmax_ = 0, f_scale_ = 0, gmax_best_ = 0, alpha0_ = 1;
+    double fx_ = 0, gmax_ = 0, f_scale_ = 0, alpha0_ = 1;
 };
 }  // namespace
 

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <vector>
 
-#include "fibernet/solve/solver_loop.hpp"
 #include "hessian_factor.hpp"
 #include "solver_util.hpp"
 
@@ -50,7 +49,7 @@ public:
         if (!std::isfinite(fx_) || !g_.allFinite())
             return Step::stop(SolveStatus::NonFinite, "non-finite energy or gradient at the start");
         f_scale_ = std::abs(fx_);  // energy scale for the line search's round-off allowance
-        gmax_best_ = gmax_;
+        watch_.start(gmax_);
         if (p_.hessian_h0 && !refactor(run, q))
             return Step::stop(SolveStatus::Failed, "Hessian factorization failed at the start");
         direction(run);
@@ -70,20 +69,12 @@ public:
         if (!lr.ok()) return recover(run, q, lr);
         restarts_ = 0;
         ++k_;
-        // Progress: an energy decrease beyond round-off, or a new lowest max|g| (below round-off the energy
-        // cannot tell, the gradient still can). A gradient inconsistent with the energy shows neither.
-        const double gn_max = detail::max_abs(gn_);
-        const double noise = 1e-16 * std::abs(fx_);  // any decrease beyond the last bits
-        const bool progress = lr.f < fx_ - noise || gn_max < 0.9 * gmax_best_;
-        gmax_best_ = std::min(gmax_best_, gn_max);
-        no_decrease_ = progress ? 0 : no_decrease_ + 1;
+        watch_.update(fx_, lr.f, detail::max_abs(gn_));
         remember(q);
         q.swap(xn_), g_.swap(gn_), fx_ = lr.f, gmax_ = detail::max_abs(g_);
         if (gmax_ <= run.options().tol) return Step::moved();
-        if (no_decrease_ >= p_.stall_iterations)
-            return Step::stop(SolveStatus::Stalled, "no energy decrease beyond round-off and no new minimum of max|g| for " +
-                                                        std::to_string(no_decrease_) + " iterations at max|g| = " +
-                                                        show(gmax_), true);
+        Step stop;
+        if (watch_.stalled(p_.stall_iterations, gmax_, stop)) return stop;
         if (p_.hessian_h0 && p_.refactor_stall > 0 && k_ - factor_iter_ >= p_.refactor_stall) {
             // A window of refactor_stall iterations since the last check: refactor if max|g| did not halve.
             if (gmax_ > 0.5 * gmax_at_factor_) {
@@ -118,10 +109,7 @@ private:
             alpha0_ = p_.hessian_h0 ? 1.0 : 1.0 / d_.norm();
             return Step::again();
         }
-        const SolveStatus st =
-            lr.outcome == LineSearchOutcome::NonFinite ? SolveStatus::NonFinite : SolveStatus::LineSearchFailed;
-        return Step::stop(st, "line search: " + to_string(lr.outcome) + " after " + std::to_string(lr.evals) +
-                                  " evaluations at max|g| = " + show(gmax_));
+        return detail::line_search_stop(lr, gmax_);
     }
 
     // The new pair (s, y) into the ring buffer of the newest m, if its curvature is positive.
@@ -183,8 +171,9 @@ private:
     detail::HessianFactor factor_;
     Eigen::SparseMatrix<double> H_;
     int k_ = 0, factor_iter_ = -1, factored_at_ = -1;  // iterations; window start; iteration of the last factorization
-    double fx_ = 0, gmax_ = 0, gmax_at_factor_ = 0, f_scale_ = 0, gmax_best_ = 0, alpha0_ = 1;
-    int restarts_ = 0, no_decrease_ = 0;
+    double fx_ = 0, gmax_ = 0, gmax_at_factor_ = 0, f_scale_ = 0, alpha0_ = 1;
+    int restarts_ = 0;
+    detail::StallWatch watch_;
 };
 }  // namespace
 
