@@ -89,10 +89,9 @@ void register_modulus(CLI::App& app) {
             ModuliOptions mo;
             // What the solver accepted (tol, or Newton's round-off floor, measured on the Hessian it used).
             mo.equilibrium_tol = std::max({mo.equilibrium_tol, s.solver.tol, eq.result.grad_max});
-            // The solver's factorization, already analyzed for this pattern (if it shares one).
-            LinearSolver* llt = solver->capabilities().shares_factorization ? solver->factorization_for(e.hessian_pattern())
-                                                                            : nullptr;
-            const auto mods = linear_moduli(e, eq.q, F, modes, mo, &info, llt);
+            // The solver's factorization, already analyzed for this pattern, if it shares one (else null: its own).
+            LinearSolver* shared = solver->factorization_for(e.hessian_pattern());
+            const auto mods = linear_moduli(e, eq.q, F, modes, mo, &info, shared);
             moduli = nlohmann::json::object();
             for (const auto& M : mods) {
                 ok = ok && M.ok;

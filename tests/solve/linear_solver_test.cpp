@@ -40,7 +40,8 @@ TEST_CASE("linear solvers: on a positive definite matrix both solve H + shift I 
             const Eigen::MatrixXd X = s->solve_many(B);
             // A well-conditioned matrix (diagonally dominant: 6 - 0.3 against at most 4.8 off the diagonal): backward error at round-off.
             CHECK((M * X - B).norm() <= 1e-12 * B.norm());
-            CHECK((X.col(1) - s->solve(B.col(1))).norm() <= 1e-14 * X.col(1).norm());
+            // One and several right-hand sides may take different BLAS kernels: equal to the backward error's bound.
+            CHECK((X.col(1) - s->solve(B.col(1))).norm() <= 1e-12 * X.col(1).norm());
         }
     }
 }

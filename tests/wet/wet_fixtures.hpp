@@ -1,6 +1,7 @@
 #pragma once
 // Small hand-made networks for the wet tests.
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <cmath>
 #include <vector>
 
@@ -43,6 +44,12 @@ inline Eigen::VectorXd perturb(Eigen::VectorXd q, double amp, std::uint64_t seed
     Rng rng(seed);
     for (int i = 0; i < q.size(); ++i) q[i] += amp * (2 * rng.uniform() - 1);
     return q;
+}
+
+// The symmetric matrix whose upper triangle is `upper`, dense (for small test networks).
+inline Eigen::MatrixXd dense(const Eigen::SparseMatrix<double>& upper) {
+    const Eigen::MatrixXd U(upper);
+    return Eigen::MatrixXd(U.selfadjointView<Eigen::Upper>());
 }
 
 inline Network mikado(double L, double q, double pl, std::uint64_t seed) {

@@ -13,11 +13,6 @@ using namespace fibernet;
 using namespace wetfix;
 
 namespace {
-Eigen::MatrixXd dense(const Eigen::SparseMatrix<double>& upper) {
-    const Eigen::MatrixXd U(upper);
-    return Eigen::MatrixXd(U.selfadjointView<Eigen::Upper>());
-}
-
 void check_region(const Model& m, const Eigen::Matrix2d& F, std::uint64_t seed) {
     NetworkEnergy dry(m);
     Eigen::VectorXd q = perturb(dry.affine_map(dry.dofs(m.x), Eigen::Matrix2d::Identity(), F), 0.02, seed);

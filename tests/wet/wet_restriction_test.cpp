@@ -13,11 +13,6 @@ using namespace fibernet;
 using namespace wetfix;
 
 namespace {
-Eigen::MatrixXd dense(const Eigen::SparseMatrix<double>& upper) {
-    const Eigen::MatrixXd U(upper);
-    return Eigen::MatrixXd(U.selfadjointView<Eigen::Upper>());
-}
-
 struct Wetted {
     Network net = mikado(2.5, 6, 0.5, 5);
     Model m = model_of(net, 8);

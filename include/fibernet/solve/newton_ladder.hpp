@@ -53,9 +53,18 @@ public:
     virtual bool modified() const { return false; }
 };
 
-class ModifiedLdlRung : public NewtonRung {
+// A rung that factors with a linear solver.
+class FactoringRung : public NewtonRung {
 public:
-    explicit ModifiedLdlRung(LinearSolver& lin) : lin_(lin) {}
+    explicit FactoringRung(LinearSolver& lin) : lin_(lin) {}
+
+protected:
+    LinearSolver& lin_;
+};
+
+class ModifiedLdlRung : public FactoringRung {
+public:
+    using FactoringRung::FactoringRung;
     std::string name() const override { return "modified " + lin_.name(); }
     int level() const override { return 0; }
     bool direction(LadderState& s, Eigen::VectorXd& d, double& shift) override;
@@ -63,41 +72,31 @@ public:
     int negative_pivots() const { return lin_.negative_pivots(); }
 
 private:
-    LinearSolver& lin_;
     bool modified_ = false;
 };
 
-class ShiftedHessianRung : public NewtonRung {
+class ShiftedHessianRung : public FactoringRung {
 public:
-    explicit ShiftedHessianRung(LinearSolver& lin) : lin_(lin) {}
+    using FactoringRung::FactoringRung;
     std::string name() const override { return "shifted exact " + lin_.name(); }
     int level() const override { return 0; }
     bool direction(LadderState& s, Eigen::VectorXd& d, double& shift) override;
-
-private:
-    LinearSolver& lin_;
 };
 
-class ProjectedHessianRung : public NewtonRung {
+class ProjectedHessianRung : public FactoringRung {
 public:
-    explicit ProjectedHessianRung(LinearSolver& lin) : lin_(lin) {}
+    using FactoringRung::FactoringRung;
     std::string name() const override { return "projected " + lin_.name(); }
     int level() const override { return 1; }
     bool direction(LadderState& s, Eigen::VectorXd& d, double& shift) override;
-
-private:
-    LinearSolver& lin_;
 };
 
-class ProjectedShiftRung : public NewtonRung {
+class ProjectedShiftRung : public FactoringRung {
 public:
-    explicit ProjectedShiftRung(LinearSolver& lin) : lin_(lin) {}
+    using FactoringRung::FactoringRung;
     std::string name() const override { return "projected shifted " + lin_.name(); }
     int level() const override { return 2; }
     bool direction(LadderState& s, Eigen::VectorXd& d, double& shift) override;
-
-private:
-    LinearSolver& lin_;
 };
 
 class SteepestDescentRung : public NewtonRung {

@@ -1,6 +1,7 @@
 #pragma once
 // Every solver `--solver` can name, in one table: name, one line of documentation and a factory with the solver's
-// default parameters (its capabilities come from the solver itself, Solver::capabilities()). Adding a solver is one row here (src/solve/solver_registry.cpp).
+// default parameters (its capabilities come from the solver itself, Solver::capabilities()). Adding a solver is one
+// row here (src/solve/solver_registry.cpp).
 //   newton (newton.hpp); lbfgs, lbfgs-hessian (lbfgs.hpp); nlopt-lbfgs, nlopt-tnewton, nlopt-var2
 //   (nlopt_solver.hpp); ipopt (ipopt_solver.hpp); fire (fire.hpp); cg (cg.hpp).
 #include <functional>
