@@ -3,9 +3,11 @@
 // Prints one JSON line per run with the time split: dry Newton, wet Newton, event handling, pore analysis.
 //   bench_wet [N=1000] [q=10] [beta=0.01] [max_rounds=1000] [newton_max_iter=500] [scheme=seed] [seed=1] [move_margin=0.1]
 //             [round_iterations=10] [warm_start=1] [newton_ldl=1] [local_fraction=0.25] [local_threshold=0.1]
-//             [local_hops=3]
+//             [local_hops=3] [model=events]
 // The "newton" block sums the wet solves' time split over all rounds.
 // Environment: BENCH_VERBOSE=1 prints a line per active-set round, BENCH_NEWTON_VERBOSE=1 a line per Newton iteration.
+// Smooth model (model=smooth): BENCH_PATTERN_DISTANCE, BENCH_SKIN, BENCH_MAX_STEP override SmoothWetParams'
+// pattern_distance and skin and SmoothRelaxOptions' max_step.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -33,6 +35,7 @@ int main(int argc, char** argv) {
     const double local_fraction = argc > 12 ? std::atof(argv[12]) : ActiveSetOptions{}.local_fraction;
     const double local_threshold = argc > 13 ? std::atof(argv[13]) : ActiveSetOptions{}.local_threshold;
     const int local_hops = argc > 14 ? std::atoi(argv[14]) : ActiveSetOptions{}.local_hops;
+    const WetModel model = parse_wet_model(argc > 15 ? argv[15] : "events");
     const auto t0 = std::chrono::steady_clock::now();
     MikadoParams mp;
     mp.q = q, mp.pl = 0.5, mp.seed = seed;
@@ -53,6 +56,12 @@ int main(int argc, char** argv) {
     opt.active_set.local_fraction = local_fraction;
     opt.active_set.local_threshold = local_threshold;
     opt.active_set.local_hops = local_hops;
+    opt.model = model;
+    opt.smooth_relax.round_iterations = round_iterations;
+    opt.smooth_relax.progress = std::getenv("BENCH_VERBOSE") != nullptr;
+    if (const char* v = std::getenv("BENCH_PATTERN_DISTANCE")) opt.smooth.pattern_distance = std::atof(v);
+    if (const char* v = std::getenv("BENCH_SKIN")) opt.smooth.skin = std::atof(v);
+    if (const char* v = std::getenv("BENCH_MAX_STEP")) opt.smooth_relax.max_step = std::atof(v);
     opt.active_set.verbose = std::getenv("BENCH_VERBOSE") != nullptr;  // a line per active-set round on stderr
     opt.solver_options.tol = 1e-8;
     opt.solver_options.max_iter = max_iter;
@@ -65,13 +74,16 @@ int main(int argc, char** argv) {
         "\"seconds\": {\"build\": %.3f, \"dry\": %.3f, \"wet_newton\": %.3f, \"wet_local\": %.3f, \"events\": %.3f, \"update\": %.3f, \"gradient\": %.3f, \"local_setup\": %.3f, \"pores\": %.3f, "
         "\"total\": %.3f}, \"newton\": {\"factorizations\": %d, \"assembly\": %.3f, "
         "\"factorization\": %.3f, \"solve\": %.3f, \"line_search\": %.3f, \"total\": %.3f}, \"newton_local\": {\"assembly\": %.3f, "
-        "\"factorization\": %.3f, \"solve\": %.3f, \"line_search\": %.3f, \"total\": %.3f}, \"message\": \"%s\"}\n",
+        "\"factorization\": %.3f, \"solve\": %.3f, \"line_search\": %.3f, \"total\": %.3f}, \"model\": \"%s\", "
+        "\"smooth\": {\"list_builds\": %d, \"pattern_builds\": %d, \"stale_patterns\": %d, \"grad_max\": %.3g, "
+        "\"seconds_patterns\": %.3f}, \"message\": \"%s\"}\n",
         net.fibers.size(), q, beta, m.num_nodes(), r.initial_bridges.size(), r.active.bridges.size(), r.active.rounds, r.active.local_rounds, r.active.local_iterations, r.wet.energy.total(), r.wet.energy.capillary,
         r.active.stable ? "true" : "false", r.active.cycling ? "true" : "false", r.active.cycles_broken, r.active.solver_iterations,
         r.active.events.total(), t_build, r.seconds_dry, r.seconds_wet_solve, r.active.seconds_local, r.seconds_events, r.active.seconds_update, r.active.seconds_gradient, r.active.seconds_local_setup, r.seconds_pores, total,
         r.active.factorizations, r.active.timings.assembly, r.active.timings.factorization, r.active.timings.solve,
         r.active.timings.line_search, r.active.timings.total, r.active.timings_local.assembly,
         r.active.timings_local.factorization, r.active.timings_local.solve, r.active.timings_local.line_search,
-        r.active.timings_local.total, r.active.message.c_str());
+        r.active.timings_local.total, to_string(model).c_str(), r.smooth.list_builds, r.smooth.pattern_builds,
+        r.smooth.stale_patterns, r.smooth.grad_max, r.smooth.seconds_patterns, r.active.message.c_str());
     return 0;
 }

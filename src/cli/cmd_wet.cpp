@@ -289,6 +289,15 @@ void register_wet(CLI::App& app) {
         opt.active_set.local_threshold = s.wet.local_threshold;
         opt.active_set.local_hops = s.wet.local_hops;
         opt.active_set.bundle_partners = s.wet.bundle_partners;
+        opt.model = parse_wet_model(s.wet.model);
+        opt.smooth.skin = s.wet.skin;
+        opt.smooth.pair.crossing_width = s.wet.crossing_width;  // 0: from the model (run_wet)
+        opt.smooth.pair.contact = s.wet.contact_distance;
+        opt.smooth.pair.overlap_width = 0;  // the fiber radius
+        opt.smooth_relax.round_iterations = s.wet.round_iterations;
+        opt.smooth_relax.max_rounds = s.wet.max_rounds;
+        opt.smooth_relax.ldl = s.wet.newton_ldl;
+        opt.smooth_relax.progress = w->verbose || !w->quiet;
         if (w->verbose && w->quiet) throw InputError("--verbose and --quiet contradict each other");
         opt.moduli = !w->no_moduli;
         if (o_ms->count()) {
@@ -353,6 +362,10 @@ void register_wet(CLI::App& app) {
             {"local_threshold", s.wet.local_threshold},
             {"local_hops", s.wet.local_hops},
             {"bundle_partners", s.wet.bundle_partners},
+            {"model", s.wet.model},
+            {"crossing_width", s.wet.crossing_width},
+            {"contact_distance", s.wet.contact_distance},
+            {"skin", s.wet.skin},
             {"free_box", s.wet.free_box},
             {"free_box_shape", s.wet.free_box ? nlohmann::json(s.wet.free_box_shape) : nlohmann::json()},
             {"free_box_tol", s.wet.free_box ? nlohmann::json(s.wet.free_box_tol) : nlohmann::json()},
@@ -537,6 +550,14 @@ void register_wet(CLI::App& app) {
                  {"solver", solve_json(r.active.last, s.solver.tol)},
                  {"free_box", opt.free_box.enabled ? free_box_json(r.free_box, opt.free_box) : nlohmann::json()},
                  {"solver_iterations", r.active.solver_iterations},
+                 {"smooth", opt.model != WetModel::Smooth ? nlohmann::json()
+                                                         : nlohmann::json{{"rounds", r.smooth.rounds},
+                                                                          {"grad_max", r.smooth.grad_max},
+                                                                          {"list_builds", r.smooth.list_builds},
+                                                                          {"pattern_builds", r.smooth.pattern_builds},
+                                                                          {"stale_patterns", r.smooth.stale_patterns},
+                                                                          {"factorizations", r.smooth.factorizations},
+                                                                          {"seconds_patterns", r.smooth.seconds_patterns}}},
                  {"seconds",
                   {{"dry", r.seconds_dry}, {"wet_solve", r.seconds_wet_solve}, {"events", r.seconds_events},
                    {"pores", r.seconds_pores}, {"moduli", r.seconds_moduli},

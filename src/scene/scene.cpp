@@ -72,6 +72,15 @@ void Scene::check_values() const {
                 "must lie in (0, 1)");
     check_value(wet.local_hops >= 0, wet.local_hops, source, "[wet].local_hops", "must be >= 0");
     check_value(wet.bundle_partners >= 0, wet.bundle_partners, source, "[wet].bundle_partners", "must be >= 0 (0: no cap)");
+    if (wet.model != "events" && wet.model != "smooth")
+        throw InputError(source + ": [wet].model = '" + wet.model + "' is unknown (expected events or smooth)");
+    check_value(std::isfinite(wet.crossing_width) && wet.crossing_width >= 0, wet.crossing_width, source,
+                "[wet].crossing_width", "must be >= 0 (0: the fiber radius)");
+    check_value(std::isfinite(wet.contact_distance) && wet.contact_distance >= 0, wet.contact_distance, source,
+                "[wet].contact_distance", "must be >= 0 (0: the fiber diameter)");
+    check_value(std::isfinite(wet.skin) && wet.skin > 0, wet.skin, source, "[wet].skin", "must be > 0");
+    if (wet.model == "smooth" && wet.free_box)
+        throw InputError(source + ": [wet].free_box is not available with [wet].model = 'smooth' yet");
     if (wet.free_box_shape != "full" && wet.free_box_shape != "isotropic")
         throw InputError(source + ": [wet].free_box_shape = '" + wet.free_box_shape +
                          "' is unknown (expected isotropic or full)");

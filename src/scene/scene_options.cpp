@@ -137,6 +137,18 @@ std::vector<SceneOption> declare() {
                 "excluded volume: a segment adheres along at most N other fibers (0: no cap; 2: flat ribbon; "
                 "6: close-packed; docs/wet.md)",
                 [](Scene& s) -> int& { return s.wet.bundle_partners; }));
+    add(text("wet", "model", "--wet-model",
+             "capillary model: events (bridges moved, formed, ruptured between solves) | smooth (one smooth energy "
+             "over all segment pairs, docs/wet.md)",
+             [](Scene& s) -> std::string& { return s.wet.model; }));
+    add(real("wet", "crossing_width", "--crossing-width",
+             "smooth model: distance over which a crossing passes between segments, seed units (0: fiber radius 1/a)",
+             [](Scene& s) -> double& { return s.wet.crossing_width; }));
+    add(real("wet", "contact_distance", "--contact-distance",
+             "smooth model: aligned fibers closer than this adhere, seed units (0: fiber diameter 2/a)",
+             [](Scene& s) -> double& { return s.wet.contact_distance; }));
+    add(real("wet", "skin", "--skin", "smooth model: neighbour-list skin, seed units (also Newton's largest step)",
+             [](Scene& s) -> double& { return s.wet.skin; }));
     return v;
 }
 

@@ -238,7 +238,8 @@ private:
                 level = 3, d_ = -g_ / dm;
             }
             const double gd = g_.dot(d_);
-            alpha = 1;
+            const double dmax = d_.size() ? d_.lpNorm<Eigen::Infinity>() : 0.0;
+            alpha = opt_.max_step > 0 && dmax > opt_.max_step ? opt_.max_step / dmax : 1.0;
             for (int k = 0; k < kMaxHalvings; ++k, alpha *= 0.5) {
                 qt_ = q + alpha * d_;
                 if (eliminating_) ne_->eliminate(f, qt_, local_tol_, time_left(run));

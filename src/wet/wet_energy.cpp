@@ -132,37 +132,14 @@ void WetEnergy::strain_derivatives(const Eigen::VectorXd& q, const Eigen::Matrix
                                    bool comoving) const {
     dry_.evaluate(q, F_, dF, kStrain | (comoving ? kComoving : 0u), out);
     if (!active()) return;
-    const Model& m = dry_.model();
     const Eigen::VectorXd x = dry_.positions(q, F_);
-    const Eigen::Matrix2d B0 = m.box.B0(), B = F_ * B0, V = dF * F_.inverse();
-    Vector16d g, w, Hw;
+    const Eigen::Matrix2d B = F_ * dry_.model().box.B0();
+    Vector16d g;
     Matrix16d He;
     for (const BridgeElement& e : elements_) {
         const Vector16d X = element_coordinates(e, x, B);
         bridge_element_energy(e, X, params_.beta, params_.law, &g, &He);
-        w.setZero();
-        int first = -1;
-        for (int a = 0; a < 8; ++a) {
-            if (e.node[a] < 0) continue;
-            if (first < 0) first = a;
-            if (comoving) {
-                w.segment<2>(2 * a) = V * (X.segment<2>(2 * a) - X.segment<2>(2 * first));
-                continue;
-            }
-            Eigen::Vector2d r = B0 * e.shift[a].cast<double>();
-            if (dry_.dof(e.node[a], 0) < 0) r += m.x.segment<2>(2 * e.node[a]);  // a fixed node sits at F x_ref
-            w.segment<2>(2 * a) = dF * r;
-        }
-        Hw.noalias() = He * w;
-        out.dE_dt += g.dot(w);
-        const double tt = w.dot(Hw);
-        out.d2E_dt2 += tt;
-        out.d2E_dt2_size += std::abs(tt);
-        for (int a = 0; a < 8; ++a)
-            for (int c = 0; c < 2 && e.node[a] >= 0; ++c) {
-                const int r = dry_.dof(e.node[a], c);
-                if (r >= 0) out.d2E_dqdt[r] += Hw[2 * a + c];
-            }
+        add_strain_terms<8>(dry_, F_, dF, comoving, e.node, e.shift, X, g, He, out);
     }
 }
 

@@ -4,7 +4,7 @@
 
 namespace fibernet {
 
-std::vector<Modulus> wet_linear_moduli(WetEnergy& W, const Eigen::VectorXd& q, const std::vector<StrainMode>& modes,
+std::vector<Modulus> wet_linear_moduli(WetObjective& W, const Eigen::VectorXd& q, const std::vector<StrainMode>& modes,
                                        const ModuliOptions& opt, ModuliInfo* info) {
     const NetworkEnergy& dry = W.dry();
     Eigen::SparseMatrix<double> H = W.hessian_pattern();

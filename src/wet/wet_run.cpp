@@ -39,6 +39,99 @@ void shear_moduli(WetState& s, const NetworkEnergy& dry, const Eigen::Matrix2d& 
 }
 }  // namespace
 
+namespace {
+// The smooth model's two shear moduli (as shear_moduli): the second difference of relaxed smooth energies at
+// gamma = +-h and the exact linear modulus of the smooth energy.
+void smooth_shear_moduli(WetState& s, const NetworkEnergy& dry, const Eigen::Matrix2d& F, const FiberPairs& dry_pairs,
+                         const WetRunOptions& opt, Solver& solver) {
+    double E[3];
+    const double A = std::abs((F * dry.model().box.B0()).determinant()), h = opt.modulus_strain;
+    s.shear_modulus_fd = std::numeric_limits<double>::quiet_NaN();
+    bool ok = true;
+    for (int k = -1; k <= 1 && ok; ++k) {
+        Eigen::Matrix2d S = Eigen::Matrix2d::Identity();
+        S(0, 1) = k * h;
+        const Eigen::Matrix2d Fk = S * F;
+        Eigen::VectorXd qk = dry.affine_map(s.q, F, Fk);
+        SmoothWetEnergy W(dry, Fk, opt.smooth, dry_pairs, qk);
+        ok = relax_smooth_wet(W, solver, qk, opt.smooth_relax).converged;
+        E[k + 1] = W.value(qk);
+    }
+    if (ok) s.shear_modulus_fd = (E[0] - 2 * E[1] + E[2]) / (A * h * h);
+    SmoothWetEnergy W(dry, F, opt.smooth, dry_pairs, s.q);
+    const Modulus M = wet_linear_moduli(W, s.q, {shear_mode(F, A)}).front();
+    s.shear_modulus = M.ok ? M.value : std::numeric_limits<double>::quiet_NaN();
+    s.shear_modulus_error = M.ok ? M.error : std::numeric_limits<double>::quiet_NaN();
+}
+
+// The dry crossings of the smooth model: those the rule leaves dry and every crosslink (a crosslinked pair gets no
+// capillary term at its crosslink, issue 22).
+FiberPairs smooth_dry_pairs(const Network& net, const WettingRule& rule) {
+    FiberPairs out = dry_pairs(net, rule);
+    for (const Crossing& c : net.crossings)
+        if (c.crosslink) out.insert({std::min(c.f1, c.f2), std::max(c.f1, c.f2)});
+    return out;
+}
+
+// The smooth model's wet relaxation and what follows it (run_wet's second half).
+void run_wet_smooth(WetRun& run, const Network& net, const NetworkEnergy& dry, const Eigen::Matrix2d& F,
+                    const WetRunOptions& opt, Solver& solver) {
+    const Model& m = dry.model();
+    const Eigen::Matrix2d B = F * m.box.B0();
+    const FiberPairs dry_pairs = smooth_dry_pairs(net, opt.rule);
+    SmoothWetParams sp = opt.smooth;
+    sp.pair.beta = opt.params.beta, sp.pair.law = opt.params.law;
+    // Widths not given (0): the fiber's own sizes, radius 1/a and diameter 2/a (seed units).
+    const double r = 1 / m.aspect_ratio;
+    if (sp.pair.crossing_width <= 0) sp.pair.crossing_width = r;
+    if (sp.pair.contact <= 0) sp.pair.contact = 2 * r;
+    if (sp.pair.overlap_width <= 0) sp.pair.overlap_width = r;
+    WetRunOptions o = opt;
+    o.smooth = sp;
+    run.wet.q = run.dry.q;
+    SmoothWetEnergy W(dry, F, sp, dry_pairs, run.wet.q);
+    run.initial_bridges = W.bridges(run.wet.q);
+    SmoothRelaxOptions ro = opt.smooth_relax;
+    run.smooth = relax_smooth_wet(W, solver, run.wet.q, ro);
+    run.seconds_wet_solve = run.smooth.seconds;
+    run.active.seconds_solve = run.smooth.seconds;
+    run.wet.converged = run.smooth.converged;
+    run.active.last = run.smooth.last;
+    run.active.rounds = run.smooth.rounds;
+    run.active.solver_iterations = run.smooth.iterations;
+    run.active.factorizations = run.smooth.factorizations;
+    run.active.timings = run.smooth.timings;
+    run.active.stable = run.smooth.converged;
+    run.active.message = run.smooth.message;
+    run.active.bridges = W.bridges(run.wet.q);
+    const SmoothWetSplit split = W.split(run.wet.q);
+    run.wet.energy.stretch = split.stretch, run.wet.energy.bend = split.bend;
+    run.wet.energy.capillary = split.capillary();
+    double t0 = now();
+    const Eigen::VectorXd x = dry.positions(run.wet.q, F);
+    run.wet.pores = pores(m, x, B);
+    run.bundles = bundles(m, x, B, run.active.bridges, opt.bundle_angle_deg);
+    run.seconds_pores += now() - t0;
+    if (opt.moduli && run.wet.converged) {
+        t0 = now();
+        smooth_shear_moduli(run.wet, dry, F, dry_pairs, o, solver);
+        run.seconds_moduli += now() - t0;
+    }
+    if (opt.free_box.enabled) {
+        run.free_box.F0 = run.free_box.F = F;
+        run.free_box.message = "not attempted: the free box is not yet available on the smooth model";
+    }
+}
+}  // namespace
+
+WetModel parse_wet_model(const std::string& s) {
+    if (s == "events") return WetModel::Events;
+    if (s == "smooth") return WetModel::Smooth;
+    throw InputError("wet model '" + s + "' is not one of: events, smooth");
+}
+
+std::string to_string(WetModel m) { return m == WetModel::Smooth ? "smooth" : "events"; }
+
 double relaxed_shear_modulus(const NetworkEnergy& dry, const Eigen::Matrix2d& F, const Eigen::VectorXd& q,
                              const std::vector<Bridge>& bridges, const WetParams& params, Solver& solver, double h) {
     double E[3];
@@ -102,6 +195,10 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
             shear_moduli(run.dry, dry, F, {}, none, *solver, opt.modulus_strain);
             run.seconds_moduli += now() - t0;
         }
+    }
+    if (opt.model == WetModel::Smooth) {
+        run_wet_smooth(run, net, dry, F, opt, *solver);
+        return run;
     }
     // Wet: bridges at the dry equilibrium's crossings (the network's crossings, which the dry relaxation moved by
     // little), made consistent with the geometry before the first solve.

@@ -352,3 +352,38 @@ TEST_CASE("cli wet: a re-run invalidates the old results, and SIGINT keeps the f
         CHECK(!any_tmp(out));
     }
 }
+
+TEST_CASE("cli wet: the smooth model relaxes to an equilibrium of the whole energy and reports it", "[wet][cli][smooth]") {
+    const std::string out = tmpdir() + "/smooth";
+    REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
+    REQUIRE(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --tol 1e-9 -q -o " + out) == 0);
+    const nlohmann::json j = read_json(out + "/summary.json");
+    REQUIRE(!j.is_discarded());
+    CHECK(j["wet"]["model"] == "smooth");
+    CHECK(j["wet"]["skin"] == 0.5);
+    const nlohmann::json& r = j["runs"][0];
+    CHECK(r["status"] == "stable");
+    REQUIRE(r["smooth"].is_object());
+    CHECK(r["smooth"]["grad_max"].get<double>() <= 1e-9);
+    CHECK(r["smooth"]["list_builds"].get<int>() >= 1);
+    CHECK(r["energy"]["wet"]["capillary"].get<double>() < 0);
+    CHECK(r["bridges"]["final"].get<int>() > 0);
+    // The exact linear modulus of the smooth energy and the second difference of relaxed energies agree.
+    const double G = r["shear_modulus"]["wet"].get<double>(), Gfd = r["shear_modulus_second_difference"]["wet"].get<double>();
+    CHECK(G > 0);
+    CHECK(std::abs(G - Gfd) <= 1e-3 * G);
+}
+
+TEST_CASE("cli wet: the smooth model's options are refused by name", "[wet][cli][smooth][input]") {
+    const std::string out = tmpdir() + "/smooth_bad";
+    REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
+    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model drops -q -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("'drops'") != std::string::npos);
+    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --skin 0 -q -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("[wet].skin") != std::string::npos);
+    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --crossing-width -1 -q -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("[wet].crossing_width") != std::string::npos);
+    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --free-box -q -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("free_box") != std::string::npos);
+    CHECK(!exists(out));
+}

@@ -14,28 +14,6 @@ using namespace fibernet;
 using namespace wetfix;
 
 namespace {
-struct TwoFiber {
-    Network net;
-    Model m;
-};
-
-// Fiber 1 along x, fiber 2 at angle alpha through fiber 1's midpoint, both crossing mid-segment (odd n_seg).
-TwoFiber two_fibers(double alpha_deg, int n_seg) {
-    TwoFiber t;
-    t.net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.5, 1.5, alpha_deg, 1, 0.5}}, 3);
-    t.m = model_of(t.net, n_seg);
-    t.m.fixed.assign(t.m.num_nodes(), 0);
-    for (int n : t.m.chains[0].nodes) t.m.fixed[n] = 1;
-    t.m.fixed[t.m.chains[1].nodes.front()] = t.m.fixed[t.m.chains[1].nodes.back()] = 1;
-    return t;
-}
-
-double segment_angle(const NetworkEnergy& e, const Eigen::VectorXd& q, int f, int k) {
-    const Eigen::VectorXd x = e.positions(q, Eigen::Matrix2d::Identity());
-    const FiberChain& ch = e.model().chains[f];
-    const Eigen::Vector2d d = x.segment<2>(2 * ch.nodes[k + 1]) - x.segment<2>(2 * ch.nodes[k]);
-    return std::atan2(d.y(), d.x());
-}
 
 ActiveSetResult relax(const TwoFiber& t, const NetworkEnergy& e, Eigen::VectorXd& q, double beta) {
     WetParams p;

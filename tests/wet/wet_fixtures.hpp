@@ -1,10 +1,13 @@
 #pragma once
 // Small hand-made networks for the wet tests.
+#include <catch2/catch.hpp>
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <cmath>
+#include <utility>
 #include <vector>
 
+#include "../energy/fd.hpp"
 #include "fibernet/energy/network_energy.hpp"
 #include "fibernet/model/discretize.hpp"
 #include "fibernet/network/mikado.hpp"
@@ -50,6 +53,63 @@ inline Eigen::VectorXd perturb(Eigen::VectorXd q, double amp, std::uint64_t seed
 inline Eigen::MatrixXd dense(const Eigen::SparseMatrix<double>& upper) {
     const Eigen::MatrixXd U(upper);
     return Eigen::MatrixXd(U.selfadjointView<Eigen::Upper>());
+}
+
+// Two crossing fibers (issue 6 tests): fiber 1 along x held fixed, fiber 2 at angle alpha through its midpoint
+// (both crossing mid-segment for odd n_seg) and pinned at both ends.
+struct TwoFiber {
+    Network net;
+    Model m;
+};
+
+inline TwoFiber two_fibers(double alpha_deg, int n_seg) {
+    TwoFiber t;
+    t.net = network_of({{1.5, 1.5, 0, 1, 0.5}, {1.5, 1.5, alpha_deg, 1, 0.5}}, 3);
+    t.m = model_of(t.net, n_seg);
+    t.m.fixed.assign(t.m.num_nodes(), 0);
+    for (int n : t.m.chains[0].nodes) t.m.fixed[n] = 1;
+    t.m.fixed[t.m.chains[1].nodes.front()] = t.m.fixed[t.m.chains[1].nodes.back()] = 1;
+    return t;
+}
+
+// The direction angle of segment k of fiber f at q.
+inline double segment_angle(const NetworkEnergy& e, const Eigen::VectorXd& q, int f, int k) {
+    const Eigen::VectorXd x = e.positions(q, Eigen::Matrix2d::Identity());
+    const FiberChain& ch = e.model().chains[f];
+    const Eigen::Vector2d d = x.segment<2>(2 * ch.nodes[k + 1]) - x.segment<2>(2 * ch.nodes[k]);
+    return std::atan2(d.y(), d.x());
+}
+
+// The gradient g and Hessian H of a wet energy W at q, and those of its capillary part (W less the dry energy D, whose
+// much stiffer terms would hide an error in it), against central differences of values and gradients. Returns the
+// dense Hessians of W and of its capillary part.
+template <class Energy>
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> check_against_differences(Energy& W, Energy& D, const Eigen::VectorXd& q) {
+    auto full = [](Energy& E, const Eigen::VectorXd& v, Eigen::VectorXd& g) {
+        Eigen::SparseMatrix<double> H = E.hessian_pattern();
+        E.hessian(v, g, H, false);
+        return dense(H);
+    };
+    Eigen::VectorXd g, gd;
+    const Eigen::MatrixXd Hf = full(W, q, g), Hcap = Hf - full(D, q, gd);
+    auto val = [&](const Eigen::VectorXd& v) { return W.value(v); };
+    auto grad = [&](const Eigen::VectorXd& v) {
+        Eigen::VectorXd r;
+        W.gradient(v, r);
+        return r;
+    };
+    auto capval = [&](const Eigen::VectorXd& v) { return W.value(v) - D.value(v); };
+    auto capgrad = [&](const Eigen::VectorXd& v) {
+        Eigen::VectorXd a, b;
+        W.gradient(v, a), D.gradient(v, b);
+        return Eigen::VectorXd(a - b);
+    };
+    const double h = 1e-6;
+    CHECK(fdtest::rel_err(g, fdtest::fd_gradient(val, q, h)) < 1e-6);
+    CHECK(fdtest::rel_err(Hf, fdtest::fd_jacobian(grad, q, h)) < 1e-6);
+    CHECK(fdtest::rel_err(g - gd, fdtest::fd_gradient(capval, q, h), 1e-3) < 1e-6);
+    CHECK(fdtest::rel_err(Hcap, fdtest::fd_jacobian(capgrad, q, h), 1e-3) < 1e-5);
+    return {Hf, Hcap};
 }
 
 inline Network mikado(double L, double q, double pl, std::uint64_t seed) {

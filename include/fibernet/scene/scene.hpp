@@ -42,6 +42,14 @@ struct WetSettings {
     // Excluded volume in bundles: a segment adheres along at most this many other fibers (0: no cap; 2: flat ribbon,
     // 6: close-packed; ActiveSetOptions::bundle_partners, docs/wet.md "Bundle partners").
     int bundle_partners = 0;
+    // The capillary model (docs/wet.md, "The smooth model"; issue 22): "events" (bridges moved, formed and ruptured by
+    // the active-set loop) or "smooth" (one C2 energy over all segment pairs within range, no events).
+    std::string model = "events";
+    // Smooth model: the distance over which a crossing passes from one segment to the next, the contact distance of
+    // aligned fibers, and the neighbour list's skin (seed units; 0: the fiber radius 1/a and diameter 2/a).
+    double crossing_width = 0;
+    double contact_distance = 0;
+    double skin = 0.5;
 };
 
 struct Scene {

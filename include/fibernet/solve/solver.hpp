@@ -25,6 +25,9 @@ struct SolverOptions {
     bool eliminate = false;  // Newton: nonlinear elimination of the hot places before and inside each global step
                              // (nonlinear_elimination.hpp); others ignore it
     EliminationOptions elimination;
+    double max_step = 0;     // Newton: no coordinate moves more than this in one step (the line search starts at the
+                             // step scaled down to it, and a capped step counts as a shortened one); 0 = no cap.
+                             // The smooth wet model sets it to its neighbour list's skin (smooth_wet_relax.hpp)
 
     // The one check of these options (every solver's constructor calls it): throws InputError("<where>: <name> = <v>
     // must ..."), `where` naming the solver.

@@ -15,6 +15,7 @@
 #include "fibernet/energy/network_energy.hpp"
 #include "fibernet/energy/objective.hpp"
 #include "fibernet/wet/bridge.hpp"
+#include "fibernet/wet/wet_objective.hpp"
 
 namespace fibernet {
 
@@ -28,7 +29,7 @@ struct WetSplit {
     double total() const { return stretch + bend + capillary; }
 };
 
-class WetEnergy : public Objective {
+class WetEnergy : public WetObjective {
 public:
     // Keeps a reference to `dry` (and through it to its Model), which must outlive this energy.
     WetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, std::vector<Bridge> bridges, WetParams params);
@@ -59,10 +60,10 @@ public:
     // X_0), X_0 the element's first node (each element is translation invariant, so the reference point drops out of
     // g.w and H w and only the element's own extent enters, without the cancellation of the large |v|).
     void strain_derivatives(const Eigen::VectorXd& q, const Eigen::Matrix2d& dF, EnergyEval& out,
-                            bool comoving = false) const;
+                            bool comoving = false) const override;
 
-    const NetworkEnergy& dry() const { return dry_; }
-    const Eigen::Matrix2d& F() const { return F_; }
+    const NetworkEnergy& dry() const override { return dry_; }
+    const Eigen::Matrix2d& F() const override { return F_; }
     const std::vector<Bridge>& bridges() const { return bridges_; }
     const std::vector<BridgeElement>& elements() const { return elements_; }
     const WetParams& params() const { return params_; }

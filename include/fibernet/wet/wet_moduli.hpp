@@ -20,7 +20,7 @@ namespace fibernet {
 // At an equilibrium q of W (its gradient at round-off). Modulus::affine is NaN (no affine prediction here);
 // ok = false (value undefined) if H is not positive semidefinite there or the solve failed, with the reason in
 // info->message.
-std::vector<Modulus> wet_linear_moduli(WetEnergy& W, const Eigen::VectorXd& q, const std::vector<StrainMode>& modes,
+std::vector<Modulus> wet_linear_moduli(WetObjective& W, const Eigen::VectorXd& q, const std::vector<StrainMode>& modes,
                                        const ModuliOptions& opt = {}, ModuliInfo* info = nullptr);
 
 }  // namespace fibernet

@@ -14,6 +14,7 @@
 #include "fibernet/wet/active_set.hpp"
 #include "fibernet/wet/bundles.hpp"
 #include "fibernet/wet/pores.hpp"
+#include "fibernet/wet/smooth_wet_relax.hpp"
 #include "fibernet/wet/wetting.hpp"
 
 namespace fibernet {
@@ -95,8 +96,19 @@ struct FreeBoxResult {
     double seconds = 0;
 };
 
+// Which capillary model relaxes the wet network: the event model (bridges on segment pairs, moved, formed, ruptured and
+// zipped by the active-set loop between solves; active_set.hpp) or the smooth model (one C2 energy over every segment
+// pair within range; smooth_wet_energy.hpp, issue 22).
+enum class WetModel { Events, Smooth };
+WetModel parse_wet_model(const std::string& s);  // "events" | "smooth"; InputError otherwise
+std::string to_string(WetModel m);
+
 struct WetRunOptions {
     WetParams params;
+    WetModel model = WetModel::Events;
+    SmoothWetParams smooth;      // the smooth model's pair parameters (beta and law come from `params`; widths <= 0:
+                                 // the fiber radius 1/a, the contact distance 2/a)
+    SmoothRelaxOptions smooth_relax;
     WettingRule rule;
     ActiveSetOptions active_set;
     std::string solver = "newton";
@@ -125,7 +137,8 @@ struct WetState {
 struct WetRun {
     WetState dry, wet;
     SolveResult dry_solve;
-    ActiveSetResult active;        // the wet relaxation
+    ActiveSetResult active;        // the wet relaxation (the smooth model fills bridges, last, rounds, stable, message)
+    SmoothRelaxResult smooth;      // the smooth model's relaxation
     std::vector<Bridge> initial_bridges;
     BundleStats bundles;
     FreeBoxResult free_box;        // attempted only if asked and the fixed-box wet state is stable

@@ -1,0 +1,59 @@
+#pragma once
+// Segment pairs within a distance, with a skin (as molecular dynamics lists atoms; issue 22). The distance may grow
+// with the segments' lengths: range(L) for a segment of length up to L (a pair's is the larger of its two). Built at
+// positions x_b for range + skin, the list holds every pair of segments of different fibers that can come within range
+// while no node has moved more than skin / 2 from x_b, no segment has grown beyond 1.5x its length plus the skin, and
+// the box is unchanged. Pairs of segments that share a node (at a crosslink) are left out. Broad phase: each segment's
+// bounding box, grown by its range and half the skin, is entered into every cell of a grid over the (possibly sheared)
+// periodic box that it covers (long segments cover several cells, so one long segment does not coarsen the grid);
+// pairs sharing a cell are then tested exactly. Pairs are in a fixed order (segment a ascending, then b, then image),
+// so every sum over them is the same on every platform and for any thread count.
+#include <Eigen/Core>
+#include <functional>
+#include <vector>
+
+#include "fibernet/model/model.hpp"
+
+namespace fibernet {
+
+struct SegmentPair {
+    int a = 0, b = 0;             // segments, a < b, of different fibers
+    Eigen::Vector2i image{0, 0};  // b's first node is taken at x + B image, next to a's first node
+};
+
+class NeighbourList {
+public:
+    // Keeps a reference to m. range(L) > 0, skin > 0.
+    NeighbourList(const Model& m, std::function<double(double)> range, double skin);
+
+    // Rebuilds the list at node positions x (2 per node) in the box B (model units), with the skin given at
+    // construction or, for this build, `skin` (>= that one).
+    void build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double skin = 0);
+    // The largest displacement of a node from its position at the last build (infinity if none or B differs).
+    double max_displacement(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
+    const Eigen::VectorXd& built_at() const { return x_built_; }
+    // Whether the list still holds every pair within `range` at x in the box B (built, same B, every node within
+    // skin / 2 of where it was at the build).
+    bool valid(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
+    const std::vector<SegmentPair>& pairs() const { return pairs_; }
+    int builds() const { return builds_; }
+    double skin() const { return skin_; }
+    double built_skin() const { return built_skin_; }
+
+    // Local coordinates (p0, p1, q0, q1) of pair k at positions x in box B.
+    Eigen::Matrix<double, 8, 1> coordinates(const SegmentPair& p, const Eigen::VectorXd& x,
+                                            const Eigen::Matrix2d& B) const;
+    // The four nodes of a pair and their images (in the order of coordinates()).
+    void nodes(const SegmentPair& p, int node[4], Eigen::Vector2i shift[4]) const;
+
+private:
+    const Model& m_;
+    std::function<double(double)> range_;
+    double skin_, built_skin_ = 0;
+    std::vector<SegmentPair> pairs_;
+    Eigen::VectorXd x_built_;
+    Eigen::Matrix2d B_built_ = Eigen::Matrix2d::Zero();
+    int builds_ = 0;
+};
+
+}  // namespace fibernet

@@ -1,0 +1,118 @@
+#pragma once
+// The wet network's energy as one smooth function (issue 22; docs/wet.md, "The smooth model"):
+//   E(q) = dry stretching + bending (NetworkEnergy, unchanged) + sum over segment pairs of capillary_pair_energy
+// over every pair of segments of different fibers. Pairs farther apart than the pair term's support distance have
+// exactly zero energy, so only the pairs of a neighbour list (neighbour_list.hpp, built with a skin) are evaluated; the
+// list is valid while no node has moved more than half the skin since its build; every evaluation first rebuilds it
+// where it is no longer valid, so values and gradients are always those of the whole energy. A rebuild never changes
+// the energy, only which pairs are evaluated.
+//
+// Hessian pattern. Most listed pairs are zero at any one state; the pattern holds the dry pattern and the 4-node block
+// of every *patterned* pair: those non-zero at the last rebuild() or closer than `pattern_distance` there. A Hessian
+// evaluated where a non-zero pair is not patterned leaves that pair's block out (value and gradient stay exact) and
+// sets pattern_stale(); the driver (relax_smooth_wet) then calls rebuild(). The pattern is fixed between rebuild()
+// calls, as a solver expects (objective.hpp).
+//
+// With beta = 0 no pair is evaluated and the pattern is the dry one: values, gradients and Hessians are the dry ones
+// bit for bit. Sums run in pair order after the dry terms, the same for any thread count.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include "fibernet/wet/bridge.hpp"
+#include "fibernet/wet/capillary_pair.hpp"
+#include "fibernet/wet/neighbour_list.hpp"
+#include "fibernet/wet/wet_objective.hpp"
+
+namespace fibernet {
+
+struct SmoothWetParams {
+    CapillaryPairParams pair;
+    double skin = 0.5;              // neighbour-list skin (seed units)
+    double pattern_distance = 0;    // 0: 1.5 contact + overlap_width + crossing_width
+};
+
+struct SmoothWetSplit {
+    double stretch = 0, bend = 0, crossing = 0, contact = 0;
+    double capillary() const { return crossing + contact; }
+    double total() const { return stretch + bend + crossing + contact; }
+};
+
+class SmoothWetEnergy : public WetObjective {
+public:
+    // dry_crossings: fiber pairs (lower first) whose crossings get no crossing term (crosslinked, or left dry by the
+    // wetting rule); their contact term stays. Keeps a reference to `dry`. Builds the neighbour list at q.
+    SmoothWetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, SmoothWetParams params,
+                    FiberPairs dry_crossings, const Eigen::VectorXd& q);
+    SmoothWetEnergy(const NetworkEnergy&& dry, const Eigen::Matrix2d& F, SmoothWetParams params,
+                    FiberPairs dry_crossings, const Eigen::VectorXd& q) = delete;
+
+    int size() const override { return dry_.num_dofs(); }
+    double value(const Eigen::VectorXd& q) override;
+    double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override;
+    double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool project_psd) override;
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
+
+    // Rebuilds the neighbour list and the Hessian pattern at q.
+    void rebuild(const Eigen::VectorXd& q);
+    // Whether the pattern was built with the list now in use (false once an evaluation had to rebuild the list).
+    bool pattern_current() const { return pattern_list_ == list_.builds(); }
+    // A Hessian since the last rebuild() met a non-zero pair outside the pattern.
+    bool pattern_stale() const { return stale_; }
+    int list_builds() const { return list_.builds(); }
+    int pattern_builds() const { return pattern_builds_; }
+    size_t listed_pairs() const { return list_.pairs().size(); }
+    size_t patterned_pairs() const { return n_patterned_; }
+
+    void strain_derivatives(const Eigen::VectorXd& q, const Eigen::Matrix2d& dF, EnergyEval& out,
+                            bool comoving = false) const override;
+    const NetworkEnergy& dry() const override { return dry_; }
+    const Eigen::Matrix2d& F() const override { return F_; }
+    const SmoothWetParams& params() const { return params_; }
+    const FiberPairs& dry_crossings() const { return dry_crossings_; }
+
+    SmoothWetSplit split(const Eigen::VectorXd& q) const;
+    // The non-zero pairs at q as bridges, for reports, bundles and SVGs: a pair with a crossing share (b W_A W_B > 0)
+    // is a crossing bridge, one with only a contact share a locked (bundle) bridge.
+    std::vector<Bridge> bridges(const Eigen::VectorXd& q, double* crossing_weight = nullptr) const;
+
+private:
+    double eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd);
+    bool active() const { return params_.pair.beta != 0; }
+    bool wet_crossing(const SegmentPair& p) const;
+    // Indices of the listed pairs that are non-zero at x (in list order).
+    std::vector<int> nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
+    void build_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B);
+    void local_dofs(const SegmentPair& p, int idx[8]) const;
+    // f(pair, its local coordinates) for every non-zero pair at q, in list order.
+    void for_each_nonzero(const Eigen::VectorXd& q,
+                          const std::function<void(const SegmentPair&, const Vector8d&)>& f) const;
+    // f(pair, its parts) for every non-zero pair at q, in list order.
+    void for_each_part(const Eigen::VectorXd& q,
+                       const std::function<void(const SegmentPair&, const CapillaryPairParts&)>& f) const;
+    // Rebuilds the list if it is not valid at x (and maps its pairs to the patterned ones).
+    void ensure_list(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
+    static std::uint64_t key(const SegmentPair& p);
+
+    const NetworkEnergy& dry_;
+    Eigen::Matrix2d F_;
+    SmoothWetParams params_;
+    FiberPairs dry_crossings_;
+    mutable NeighbourList list_;   // rebuilt where an evaluation finds it invalid (a cache of the geometry)
+    Eigen::SparseMatrix<double> pattern_, dry_H_;
+    std::vector<int> dry_slot_;
+    mutable std::vector<int> patterned_;  // per listed pair: its index among the patterned pairs, or -1
+    std::unordered_map<std::uint64_t, int> pattern_index_;  // patterned pair (key()) -> its index
+    int pattern_list_ = 0, pattern_builds_ = 0;
+    std::vector<int> slots_;       // 64 per patterned pair (element_slots)
+    size_t n_patterned_ = 0;
+    bool stale_ = false;
+    EnergyEval eval_;
+    std::vector<int> seg_fiber_, seg_index_;  // per segment: fiber and index in its chain
+};
+
+}  // namespace fibernet

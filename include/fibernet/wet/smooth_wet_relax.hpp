@@ -1,0 +1,43 @@
+#pragma once
+// Relaxing the smooth wet energy (smooth_wet_energy.hpp; issue 22): a solver minimizes the one energy directly. Its
+// values and gradients are always the whole energy's (the energy rebuilds its neighbour list where needed); between
+// rounds of at most `round_iterations` solver iterations the Hessian pattern is rebuilt where it no longer covers the
+// state (the list was rebuilt since, or a non-zero pair fell outside it). No bridge set, no events: a rebuild changes
+// only which pairs are evaluated and which entries the Hessian holds. Converged when the solver reports an
+// equilibrium, which then is one of the whole energy.
+#include <Eigen/Core>
+#include <string>
+
+#include "fibernet/solve/solver.hpp"
+#include "fibernet/wet/smooth_wet_energy.hpp"
+
+namespace fibernet {
+
+struct SmoothRelaxOptions {
+    // Solver iterations per round for solvers whose iterations are Newton steps (SolverCapabilities::newton_steps;
+    // others get their own max_iter per round); 0: rounds are not cut.
+    int round_iterations = 20;
+    int max_rounds = 200;
+    bool progress = false;  // a line per round on stderr
+    double max_step = -1;   // Newton: largest coordinate change per step (SolverOptions::max_step); < 0: the skin
+    bool ldl = true;        // Newton's first rung by LDL^T with flipped negative pivots (SolverOptions::ldl), beta > 0
+    bool always_rebuild = false;  // rebuild the list after every round, needed or not (tests: the same equilibrium)
+};
+
+struct SmoothRelaxResult {
+    bool converged = false;
+    std::string message;
+    SolveResult last;            // the last round's solve
+    int rounds = 0, list_builds = 0, pattern_builds = 0, stale_patterns = 0;
+    int iterations = 0, factorizations = 0, evaluations = 0;
+    double grad_max = 0;         // max|g| of the whole energy at the returned state
+    double energy = 0;
+    SolveTimings timings;        // summed over the rounds
+    double seconds_patterns = 0; // pattern rebuilds between rounds (list rebuilds inside evaluations count as assembly)
+    double seconds = 0;
+};
+
+SmoothRelaxResult relax_smooth_wet(SmoothWetEnergy& W, Solver& solver, Eigen::VectorXd& q,
+                                   const SmoothRelaxOptions& opt = {});
+
+}  // namespace fibernet

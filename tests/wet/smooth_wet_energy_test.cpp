@@ -1,0 +1,239 @@
+// The smooth wet energy (smooth_wet_energy.hpp): derivatives of the whole energy and of its capillary part against
+// central differences (crossings near nodes, at fiber ends, across the periodic box edge, in a sheared box, contacts of
+// aligned fibers, a tabulated law, fixed nodes) with the strain derivatives; beta = 0 bit for bit dry; the same on any
+// thread count; energy constant as a straight fiber slides along itself or across a crossing, and continuous along a
+// drag across nodes and off a fiber end; a bundle adheres with -beta per unit overlap.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "../energy/fd.hpp"
+#include "fibernet/util/parallel.hpp"
+#include "fibernet/wet/smooth_wet_energy.hpp"
+#include "wet_fixtures.hpp"
+
+using namespace fibernet;
+using namespace wetfix;
+
+namespace {
+
+SmoothWetParams smooth(double beta, const CapillaryLaw& law = {}) {
+    SmoothWetParams p;
+    p.pair.beta = beta, p.pair.law = law;
+    return p;
+}
+
+CapillaryLaw table() {
+    std::vector<double> a, v;
+    for (int i = 0; i <= 18; ++i) {
+        const double r = 5.0 * i * M_PI / 180;
+        a.push_back(5.0 * i), v.push_back(-std::cos(r) * std::cos(r) + 0.1 * std::sin(2 * r) * std::sin(2 * r));
+    }
+    return CapillaryLaw::tabulated(a, v, "test table");
+}
+
+// The whole energy and its capillary part (the dry part is much stiffer and would hide an error in it), and the strain
+// derivatives along simple shear and a general direction. min_pairs: non-zero pairs the layout must have.
+void check_derivatives(const Model& m, const Eigen::Matrix2d& F, double amp, std::uint64_t seed,
+                       const CapillaryLaw& law, size_t min_pairs, bool strained = false) {
+    NetworkEnergy dry(m);
+    Eigen::VectorXd q = perturb(dry.affine_map(dry.dofs(m.x), Eigen::Matrix2d::Identity(), F), amp, seed);
+    const SmoothWetParams p = smooth(2.5, law), p0 = smooth(0);
+    SmoothWetEnergy W(dry, F, p, {}, q), D(dry, F, p0, {}, q);
+    REQUIRE(W.bridges(q).size() >= min_pairs);
+    const auto hessians = check_against_differences(W, D, q);
+    const Eigen::MatrixXd& Hcap = hessians.second;
+    CHECK(!W.pattern_stale());
+
+    Eigen::Matrix2d shear = Eigen::Matrix2d::Zero(), general;
+    shear(0, 1) = 1;
+    general << 0.3, -0.7, 0.4, 0.2;
+    for (const Eigen::Matrix2d& dF : {Eigen::Matrix2d(shear * F), general}) {
+        auto at = [&](const SmoothWetParams& pp, double t) { return SmoothWetEnergy(dry, F + t * dF, pp, {}, q); };
+        auto terms = [&](const SmoothWetParams& pp, double t) {
+            EnergyEval ev;
+            at(pp, t).strain_derivatives(q, dF, ev);
+            return ev;
+        };
+        auto energy = [&](const SmoothWetParams& pp, double t) { return at(pp, t).value(q); };
+        auto gradient = [&](const SmoothWetParams& pp, double t) {
+            Eigen::VectorXd r;
+            at(pp, t).gradient(q, r);
+            return r;
+        };
+        const EnergyEval w = terms(p, 0), d = terms(p0, 0);
+        const double ht = 1e-6;
+        const double Et = (energy(p, ht) - energy(p, -ht)) / (2 * ht), Et0 = (energy(p0, ht) - energy(p0, -ht)) / (2 * ht);
+        const Eigen::VectorXd b = (gradient(p, ht) - gradient(p, -ht)) / (2 * ht);
+        const Eigen::VectorXd b0 = (gradient(p0, ht) - gradient(p0, -ht)) / (2 * ht);
+        const double Ett = (terms(p, ht).dE_dt - terms(p, -ht).dE_dt) / (2 * ht);
+        const double Ett0 = (terms(p0, ht).dE_dt - terms(p0, -ht).dE_dt) / (2 * ht);
+        INFO("capillary dE/dt " << w.dE_dt - d.dE_dt << " (fd " << Et - Et0 << "), d2E/dt2 " << w.d2E_dt2 - d.d2E_dt2
+                                << " (fd " << Ett - Ett0 << ")");
+        CHECK(std::abs((w.dE_dt - d.dE_dt) - (Et - Et0)) <= 1e-6 * (1e-3 + std::abs(Et - Et0)));
+        CHECK(std::abs((w.d2E_dt2 - d.d2E_dt2) - (Ett - Ett0)) <= 1e-5 * (1e-3 + std::abs(Ett - Ett0)));
+        CHECK(fdtest::rel_err(w.d2E_dqdt - d.d2E_dqdt, b - b0, 1e-3) < 1e-5);
+        // Comoving: E_tt + 2 v.b + v.H v and b + H v with v = dF F^-1 x (capillary part).
+        const Eigen::Matrix2d V = dF * F.inverse();
+        const Eigen::VectorXd x = dry.positions(q, F);
+        Eigen::VectorXd v(dry.num_dofs());
+        for (int i = 0; i < m.num_nodes(); ++i)
+            if (dry.dof(i, 0) >= 0) v.segment<2>(dry.dof(i, 0)) = V * x.segment<2>(2 * i);
+        EnergyEval cw, cd;
+        W.strain_derivatives(q, dF, cw, true);
+        D.strain_derivatives(q, dF, cd, true);
+        const double Ecm = (w.d2E_dt2 - d.d2E_dt2) + 2 * v.dot(w.d2E_dqdt - d.d2E_dqdt) + v.dot(Hcap * v);
+        CHECK(std::abs((cw.d2E_dt2 - cd.d2E_dt2) - Ecm) <= 1e-9 * (1 + std::abs(Ecm)));
+        CHECK(fdtest::rel_err(cw.d2E_dqdt - cd.d2E_dqdt, Eigen::VectorXd(w.d2E_dqdt - d.d2E_dqdt + Hcap * v), 1e-6) <
+              1e-8);
+        if (strained) CHECK(std::abs(w.d2E_dt2 - d.d2E_dt2) > 1e-4);
+    }
+}
+
+std::vector<Line> moved_by(std::vector<Line> lines, double dx, double dy) {
+    for (Line& l : lines) l.x += dx, l.y += dy;
+    return lines;
+}
+
+}  // namespace
+
+TEST_CASE("smooth wet energy: gradient, Hessian and strain derivatives match finite differences",
+          "[wet][smooth][gradient][hessian]") {
+    const CapillaryLaw def, tab = table();
+    Eigen::Matrix2d sheared;
+    sheared << 1, 0.3, 0, 1.1;
+    SECTION("crossing near a node of one fiber, and of both") {
+        for (const double s_at : {0.45, 0.41}) {
+            const std::vector<Line> lines = {{1.5, 1.5, 0, 1, 0.5}, {1.31, 1.5, 60, 1, s_at}};
+            const Model m = model_of(network_of(lines, 3));
+            check_derivatives(m, Eigen::Matrix2d::Identity(), 0.003, 11, def, 2);
+            check_derivatives(m, Eigen::Matrix2d::Identity(), 0.003, 12, tab, 2);
+            const Model e = model_of(network_of(moved_by(lines, -1.33, -1.49), 3));
+            check_derivatives(e, sheared, 0.003, 13, def, 2, true);
+        }
+    }
+    SECTION("crossing near a fiber end") {
+        const std::vector<Line> lines = {{1.5, 1.5, 0, 1, 0.5}, {1.005, 1.5, 50, 1, 0.5}};
+        check_derivatives(model_of(network_of(lines, 3)), Eigen::Matrix2d::Identity(), 0.002, 21, def, 1);
+        check_derivatives(model_of(network_of(moved_by(lines, -1.03, -1.49), 3)), sheared, 0.002, 22, def, 1, true);
+    }
+    SECTION("aligned fibers in contact, through the angle blend and the distance cutoff") {
+        // Fiber 2 at 3 deg and at 14 deg to fiber 1, 0.01 (one fiber diameter / 2) off it, wrapped over the box edge.
+        for (const double deg : {3.0, 14.0}) {
+            const std::vector<Line> lines = {{1.0, 1.5, 0, 1, 0.5}, {1.2, 1.51, deg, 1, 0.5}};
+            check_derivatives(model_of(network_of(lines, 3)), Eigen::Matrix2d::Identity(), 0.004, 31, def, 3);
+            check_derivatives(model_of(network_of(moved_by(lines, -1.0, -1.5), 3)), sheared, 0.004, 32, tab, 3, true);
+        }
+    }
+    SECTION("a random Mikado network, seed scheme, fixed nodes in a sheared box") {
+        Model m = model_of(mikado(2.5, 4, 0.5, 7), 4);
+        check_derivatives(m, Eigen::Matrix2d::Identity(), 0.002, 41, def, 5);
+        m.fixed.assign(m.num_nodes(), 0);
+        for (int i = 0; i < m.num_nodes(); i += 5) m.fixed[i] = 1;
+        Eigen::Matrix2d F;
+        F << 1.05, 0.2, -0.1, 0.95;
+        check_derivatives(m, F, 0.002, 42, def, 5);
+    }
+}
+
+TEST_CASE("smooth wet energy: beta = 0 is the dry energy bit for bit", "[wet][smooth]") {
+    const Model m = model_of(mikado(2.5, 4, 0.5, 3), 4);
+    NetworkEnergy dry(m);
+    const Eigen::VectorXd q = perturb(dry.dofs(m.x), 0.01, 5);
+    SmoothWetEnergy W(dry, Eigen::Matrix2d::Identity(), smooth(0), {}, q);
+    StrainedEnergy S(dry, Eigen::Matrix2d::Identity());
+    Eigen::VectorXd gw, gs;
+    Eigen::SparseMatrix<double> Hw = W.hessian_pattern(), Hs = S.hessian_pattern();
+    const double ew = W.hessian(q, gw, Hw, false), es = S.hessian(q, gs, Hs, false);
+    CHECK(ew == es);
+    CHECK((gw.array() == gs.array()).all());
+    REQUIRE(Hw.nonZeros() == Hs.nonZeros());
+    CHECK(std::equal(Hw.valuePtr(), Hw.valuePtr() + Hw.nonZeros(), Hs.valuePtr()));
+}
+
+TEST_CASE("smooth wet energy: bit for bit the same on any number of threads", "[wet][smooth][parallel]") {
+    const Model m = model_of(mikado(8, 10, 0.5, 4), 10);
+    NetworkEnergy dry(m);
+    const Eigen::VectorXd q = perturb(dry.dofs(m.x), 0.01, 9);
+    SmoothWetEnergy W(dry, Eigen::Matrix2d::Identity(), smooth(0.3), {}, q);
+    REQUIRE(W.bridges(q).size() > 1000);
+    auto evaluate = [&](int threads, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H) {
+        set_thread_count(threads);
+        H = W.hessian_pattern();
+        return W.hessian(q, g, H, false);
+    };
+    Eigen::VectorXd g1, g3;
+    Eigen::SparseMatrix<double> H1, H3;
+    const double e1 = evaluate(1, g1, H1), e3 = evaluate(3, g3, H3);
+    set_thread_count(0);
+    CHECK(e1 == e3);
+    CHECK((g1.array() == g3.array()).all());
+    CHECK(std::equal(H1.valuePtr(), H1.valuePtr() + H1.nonZeros(), H3.valuePtr()));
+}
+
+TEST_CASE("smooth wet energy: no energy change as a straight fiber slides along itself, in a bundle or across a crossing",
+          "[wet][smooth][physics]") {
+    // Fiber 2 is moved rigidly along its own axis (its nodes only, so the dry energy stays zero). Across a crossing
+    // at 50 deg, and lying 0.05 beside fiber 1 (a bundle): the capillary energy is constant while no end is near.
+    for (const double deg : {50.0, 0.0}) {
+        const double off = deg == 0 ? 0.005 : 0;
+        const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.5, 1.5 + off, deg, 0.6, 0.5}}, 3, true), 7);
+        NetworkEnergy dry(m);
+        const Eigen::VectorXd q0 = dry.dofs(m.x);
+        const Eigen::Vector2d u(std::cos(deg * M_PI / 180), std::sin(deg * M_PI / 180));
+        std::vector<double> E;
+        for (double t = -0.15; t <= 0.15; t += 0.0123) {  // seed units: up to 1.5 segments of fiber 1 either way
+            Eigen::VectorXd q = q0;
+            for (int n : m.chains[1].nodes) q.segment<2>(dry.dof(n, 0)) += 10 * t * u;
+            SmoothWetEnergy W(dry, Eigen::Matrix2d::Identity(), smooth(0.4), {}, q);
+            E.push_back(W.value(q));
+        }
+        INFO("angle " << deg);
+        CHECK(E.front() < -0.1);
+        for (double e : E) CHECK(e == Approx(E.front()).epsilon(1e-12));
+    }
+}
+
+TEST_CASE("smooth wet energy: continuous along a drag across nodes and off a fiber end", "[wet][smooth][physics]") {
+    // Fiber 2 (60 deg) dragged along x across all of fiber 1's nodes and off its end: energy and gradient change by
+    // no more than their Lipschitz bound per step (no jump), and the energy ends at zero.
+    const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.2, 1.5, 60, 0.6, 0.5}}, 3), 5);
+    NetworkEnergy dry(m);
+    const Eigen::VectorXd q0 = dry.dofs(m.x);
+    const double step = 0.002;  // seed units
+    double E_prev = NAN, max_dE = 0;
+    Eigen::VectorXd g_prev;
+    double max_dg = 0;
+    for (double t = 0; t <= 9.0; t += step) {
+        Eigen::VectorXd q = q0;
+        for (int n : m.chains[1].nodes) q[dry.dof(n, 0)] += t;
+        SmoothWetEnergy W(dry, Eigen::Matrix2d::Identity(), smooth(1.0), {}, q);
+        Eigen::VectorXd g;
+        const double E = W.gradient(q, g);
+        if (!std::isnan(E_prev)) {
+            max_dE = std::max(max_dE, std::abs(E - E_prev));
+            max_dg = std::max(max_dg, (g - g_prev).lpNorm<Eigen::Infinity>());
+        }
+        E_prev = E, g_prev = g;
+    }
+    CHECK(E_prev == 0);
+    // |dE/dx| <= beta l |dW/dx| ~ beta l / (2 eps / sin alpha) * 15/8: a jump of a bridge's worth (beta l ~ 2) fails.
+    CHECK(max_dE < 0.1);
+    CHECK(max_dg < 2.0);
+}
+
+TEST_CASE("smooth wet energy: a two-fiber bundle adheres with -beta per unit overlap", "[wet][smooth][physics]") {
+    // Two parallel fibers 0.05 apart (within the contact distance 0.2), of different discretizations, overlapping by
+    // 0.8 fiber lengths = 8 seed units.
+    for (const int n_seg : {5, 10, 40}) {
+        Network net = network_of({{1.0, 1.5, 0, 1, 0.5}, {1.2, 1.505, 0, 1, 0.5}}, 3);
+        Model m = model_of(net, n_seg);
+        NetworkEnergy dry(m);
+        const Eigen::VectorXd q = dry.dofs(m.x);
+        const double beta = 0.25;
+        SmoothWetEnergy W(dry, Eigen::Matrix2d::Identity(), smooth(beta), {}, q);
+        const SmoothWetSplit s = W.split(q);
+        INFO("n_seg " << n_seg << ": contact energy " << s.contact);
+        CHECK(s.crossing == 0);
+        CHECK(s.contact == Approx(-beta * 8).epsilon(0.05));
+    }
+}
