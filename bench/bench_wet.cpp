@@ -7,7 +7,7 @@
 // The "newton" block sums the wet solves' time split over all rounds.
 // Environment: BENCH_VERBOSE=1 prints a line per active-set round, BENCH_NEWTON_VERBOSE=1 a line per Newton iteration.
 // Smooth model (model=smooth): BENCH_PATTERN_DISTANCE, BENCH_SKIN, BENCH_MAX_STEP override SmoothWetParams'
-// pattern_distance and skin and SmoothRelaxOptions' max_step.
+// pattern_distance and skin and SmoothRelaxOptions' max_step; BENCH_ANGLES="lo hi" the blend's angles (degrees).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -62,6 +62,8 @@ int main(int argc, char** argv) {
     if (const char* v = std::getenv("BENCH_PATTERN_DISTANCE")) opt.smooth.pattern_distance = std::atof(v);
     if (const char* v = std::getenv("BENCH_SKIN")) opt.smooth.skin = std::atof(v);
     if (const char* v = std::getenv("BENCH_MAX_STEP")) opt.smooth_relax.max_step = std::atof(v);
+    if (const char* v = std::getenv("BENCH_ANGLES"))
+        std::sscanf(v, "%lf %lf", &opt.smooth.pair.angle_lo_deg, &opt.smooth.pair.angle_hi_deg);
     opt.active_set.verbose = std::getenv("BENCH_VERBOSE") != nullptr;  // a line per active-set round on stderr
     opt.solver_options.tol = 1e-8;
     opt.solver_options.max_iter = max_iter;
