@@ -1,6 +1,7 @@
 #include "fibernet/wet/smooth_wet_energy.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <stdexcept>
 
@@ -24,6 +25,9 @@ SmoothWetEnergy::SmoothWetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d
       dry_crossings_(std::move(dry_crossings)),
       list_(dry.model(), [p = params_.pair](double length) { return p.support_distance(length); }, params_.skin) {
     params_.pair.check("wet");
+    support_crossing_ = params_.pair.support_distance(0);
+    support_contact_ = params_.pair.overlap_width + 1.5 * params_.pair.contact;
+    support_slope_ = std::sin(params_.pair.angle_hi_deg * M_PI / 360);
     if (params_.pattern_distance <= 0)
         params_.pattern_distance = 1.5 * params_.pair.contact + params_.pair.overlap_width + params_.pair.crossing_width;
     const Model& m = dry.model();
@@ -55,6 +59,29 @@ std::uint64_t SmoothWetEnergy::key(const SegmentPair& p) {
            (static_cast<std::uint64_t>(p.image.x() + 128) << 8) | static_cast<std::uint64_t>(p.image.y() + 128);
 }
 
+void SmoothWetEnergy::index_list() const {
+    const std::vector<SegmentPair>& P = list_.pairs();
+    patterned_.assign(P.size(), -1);
+    wet_.resize(P.size());
+    for (size_t k = 0; k < P.size(); ++k) {
+        const auto it = pattern_index_.find(key(P[k]));
+        if (it != pattern_index_.end()) patterned_[k] = it->second;
+        wet_[k] = wet_crossing(P[k]);
+    }
+}
+
+bool SmoothWetEnergy::beyond_support(const Vector8d& X) const {
+    const double ax0 = std::min(X[0], X[2]), ax1 = std::max(X[0], X[2]), ay0 = std::min(X[1], X[3]),
+                 ay1 = std::max(X[1], X[3]);
+    const double bx0 = std::min(X[4], X[6]), bx1 = std::max(X[4], X[6]), by0 = std::min(X[5], X[7]),
+                 by1 = std::max(X[5], X[7]);
+    const double gx = std::max({0.0, bx0 - ax1, ax0 - bx1}), gy = std::max({0.0, by0 - ay1, ay0 - by1});
+    const double L = std::sqrt(std::max((X.segment<2>(2) - X.segment<2>(0)).squaredNorm(),
+                                        (X.segment<2>(6) - X.segment<2>(4)).squaredNorm()));
+    const double support = std::max(support_crossing_, support_contact_ + support_slope_ * L);
+    return gx * gx + gy * gy > support * support;
+}
+
 void SmoothWetEnergy::ensure_list(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const {
     if (list_.valid(x, B)) return;
     // A line search's trial left the list: rebuilt at the same place with a skin that reaches the trial, so that the
@@ -67,12 +94,7 @@ void SmoothWetEnergy::ensure_list(const Eigen::VectorXd& x, const Eigen::Matrix2
     } else {
         list_.build(x, B);
     }
-    const std::vector<SegmentPair>& P = list_.pairs();
-    patterned_.assign(P.size(), -1);
-    for (size_t k = 0; k < P.size(); ++k) {
-        const auto it = pattern_index_.find(key(P[k]));
-        if (it != pattern_index_.end()) patterned_[k] = it->second;
-    }
+    index_list();
 }
 
 void SmoothWetEnergy::rebuild(const Eigen::VectorXd& q) {
@@ -93,8 +115,10 @@ std::vector<int> SmoothWetEnergy::nonzero_pairs(const Eigen::VectorXd& x, const 
     const std::vector<SegmentPair>& P = list_.pairs();
     std::vector<char> on(P.size(), 0);
     parallel_ranges(P.size(), P.size() >= kParallelMin ? thread_count() : 1, [&](size_t lo, size_t hi) {
-        for (size_t k = lo; k < hi; ++k)
-            on[k] = !capillary_pair_vanishes(list_.coordinates(P[k], x, B), wet_crossing(P[k]), params_.pair);
+        for (size_t k = lo; k < hi; ++k) {
+            const Vector8d X = list_.coordinates(P[k], x, B);
+            on[k] = !beyond_support(X) && !capillary_pair_vanishes(X, wet_[k], params_.pair);
+        }
     });
     std::vector<int> out;
     for (size_t k = 0; k < P.size(); ++k)
@@ -104,6 +128,8 @@ std::vector<int> SmoothWetEnergy::nonzero_pairs(const Eigen::VectorXd& x, const 
 
 void SmoothWetEnergy::build_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) {
     const std::vector<SegmentPair>& P = list_.pairs();
+    wet_.resize(P.size());
+    for (size_t k = 0; k < P.size(); ++k) wet_[k] = wet_crossing(P[k]);
     std::vector<char> take(P.size(), 0);
     for (int k : nonzero_pairs(x, B)) take[k] = 1;
     const double dp = params_.pattern_distance;
@@ -176,7 +202,7 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
                 const SegmentPair& p = P[on[c0 + i]];
                 const Model& m = dry_.model();
                 cE[i] = capillary_pair_energy(list_.coordinates(p, x, B), m.segments[p.a].l0, m.segments[p.b].l0,
-                                              wet_crossing(p), params_.pair, g || H ? &cg[i] : nullptr,
+                                              wet_[on[c0 + i]], params_.pair, g || H ? &cg[i] : nullptr,
                                               H ? &cH[i] : nullptr, psd);
             }
         });

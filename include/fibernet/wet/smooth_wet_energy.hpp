@@ -94,8 +94,12 @@ private:
     // f(pair, its parts) for every non-zero pair at q, in list order.
     void for_each_part(const Eigen::VectorXd& q,
                        const std::function<void(const SegmentPair&, const CapillaryPairParts&)>& f) const;
-    // Rebuilds the list if it is not valid at x (and maps its pairs to the patterned ones).
+    // Rebuilds the list if it is not valid at x (and indexes it: index_list).
     void ensure_list(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
+    // Per listed pair: its patterned index and whether its crossing is wet.
+    void index_list() const;
+    // Whether the pair at X is surely zero from its segments' bounding boxes alone (farther apart than the support).
+    bool beyond_support(const Vector8d& X) const;
     static std::uint64_t key(const SegmentPair& p);
 
     const NetworkEnergy& dry_;
@@ -106,6 +110,8 @@ private:
     Eigen::SparseMatrix<double> pattern_, dry_H_;
     std::vector<int> dry_slot_;
     mutable std::vector<int> patterned_;  // per listed pair: its index among the patterned pairs, or -1
+    mutable std::vector<char> wet_;       // per listed pair: wet_crossing()
+    double support_crossing_ = 0, support_contact_ = 0, support_slope_ = 0;  // support_distance(L) = max(c, c0 + s L)
     std::unordered_map<std::uint64_t, int> pattern_index_;  // patterned pair (key()) -> its index
     int pattern_list_ = 0, pattern_builds_ = 0;
     std::vector<int> slots_;       // 64 per patterned pair (element_slots)
