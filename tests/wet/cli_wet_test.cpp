@@ -385,5 +385,7 @@ TEST_CASE("cli wet: the smooth model's options are refused by name", "[wet][cli]
     CHECK(slurp(tmpdir() + "/stderr").find("[wet].crossing_width") != std::string::npos);
     CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --free-box -q -o " + out) == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("free_box") != std::string::npos);
+    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --bundle-partners 2 -q -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("[wet].bundle_partners = 2") != std::string::npos);
     CHECK(!exists(out));
 }
