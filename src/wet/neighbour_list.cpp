@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -58,55 +59,71 @@ Eigen::Matrix<double, 8, 1> NeighbourList::coordinates(const SegmentPair& p, con
     return X;
 }
 
-void NeighbourList::build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double skin) {
-    const int ns = static_cast<int>(m_.segments.size());
-    built_skin_ = std::max(skin, skin_);
-    const bool periodic = m_.box.periodic;
-    // Open box: a box around every segment, far larger than any reach, with no images.
-    Eigen::Matrix2d G = B;
+namespace {
+
+// The segments' ends next to their wrapped midpoints and their reaches, in the frame of the grid's box G (the periodic
+// box B, or for an open box a box around every segment, far larger than any reach, without images).
+struct Frame {
+    Eigen::Matrix2d G, Gi;
     Eigen::Vector2d origin = Eigen::Vector2d::Zero();
-    std::vector<SegInfo> seg(ns);
+    double mean_reach = 1;
+};
+
+Frame segment_frame(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+                    const std::function<double(double)>& range, double skin, std::vector<SegInfo>& seg) {
+    const int ns = static_cast<int>(m.segments.size());
+    Frame fr;
+    fr.G = B;
+    seg.assign(ns, SegInfo{});
     double reach_sum = 0;
     Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
     for (int k = 0; k < ns; ++k) {
-        const Segment& s = m_.segments[k];
-        const Eigen::Vector2d a = x.segment<2>(2 * s.i), b = x.segment<2>(2 * s.j) + B * s.shift.cast<double>();
+        const Segment& s = m.segments[k];
         SegInfo& g = seg[k];
-        g.reach = range_(1.5 * (b - a).norm() + built_skin_) + 0.5 * built_skin_;
+        g.p0 = x.segment<2>(2 * s.i), g.p1 = x.segment<2>(2 * s.j) + B * s.shift.cast<double>();
+        g.reach = range(1.5 * (g.p1 - g.p0).norm() + skin) + 0.5 * skin;
         reach_sum += g.reach;
-        lo = lo.cwiseMin(a.cwiseMin(b)), hi = hi.cwiseMax(a.cwiseMax(b));
-        g.p0 = a, g.p1 = b;
+        lo = lo.cwiseMin(g.p0.cwiseMin(g.p1)), hi = hi.cwiseMax(g.p0.cwiseMax(g.p1));
     }
-    if (!periodic) {
-        const double pad = 4 * (ns > 0 ? reach_sum / ns : 1) + 1;
-        origin = lo - Eigen::Vector2d(pad, pad);
-        const Eigen::Vector2d ext = hi - lo + Eigen::Vector2d(2 * pad, 2 * pad);
-        G = ext.asDiagonal();
+    if (ns > 0) fr.mean_reach = reach_sum / ns;
+    if (!m.box.periodic) {
+        const double pad = 4 * fr.mean_reach + 1;
+        fr.origin = lo - Eigen::Vector2d(pad, pad);
+        fr.G = (hi - lo + Eigen::Vector2d(2 * pad, 2 * pad)).asDiagonal();
     }
-    const Eigen::Matrix2d Gi = G.inverse();
-    for (SegInfo& g : seg) {
-        if (periodic) {
-            const Eigen::Vector2d f = Gi * (0.5 * (g.p0 + g.p1));
+    fr.Gi = fr.G.inverse();
+    if (m.box.periodic)
+        for (SegInfo& g : seg) {
+            const Eigen::Vector2d f = fr.Gi * (0.5 * (g.p0 + g.p1));
             g.wrap = Eigen::Vector2i(static_cast<int>(std::floor(f.x())), static_cast<int>(std::floor(f.y())));
-            const Eigen::Vector2d t = G * g.wrap.cast<double>();
+            const Eigen::Vector2d t = fr.G * g.wrap.cast<double>();
             g.p0 -= t, g.p1 -= t;
         }
-    }
-    // Cells about twice the mean reach a side (at least 1 per side); widths across the box's sides.
-    const double area = std::abs(G.determinant());
-    const double side = std::max(2 * (ns > 0 ? reach_sum / ns : 1.0), 1e-9);
-    const int nx = std::max(1, static_cast<int>(std::floor(area / G.col(1).norm() / side)));
-    const int ny = std::max(1, static_cast<int>(std::floor(area / G.col(0).norm() / side)));
-    std::vector<std::vector<Entry>> cell(static_cast<size_t>(nx) * ny);
-    std::vector<std::vector<Entry>> covers(ns);  // per segment: the cells it covers (k: the cell's index) and wraps
+    return fr;
+}
+
+// Each segment's grown box entered into every cell of the grid it covers (cells about twice the mean reach a side,
+// widths measured across the box's sides), and per segment the cells it covers.
+struct Grid {
+    std::vector<std::vector<Entry>> cell, covers;  // covers: k is the cell's index
+};
+
+Grid cover_cells(const std::vector<SegInfo>& seg, const Frame& fr, bool periodic) {
+    const int ns = static_cast<int>(seg.size());
+    const double area = std::abs(fr.G.determinant()), side = std::max(2 * fr.mean_reach, 1e-9);
+    const int nx = std::max(1, static_cast<int>(std::floor(area / fr.G.col(1).norm() / side)));
+    const int ny = std::max(1, static_cast<int>(std::floor(area / fr.G.col(0).norm() / side)));
+    Grid grid;
+    grid.cell.resize(static_cast<size_t>(nx) * ny);
+    grid.covers.resize(ns);
     for (int k = 0; k < ns; ++k) {
         const SegInfo& g = seg[k];
         // The grown box's corners in grid coordinates (their bounding box there covers it in a sheared box too).
-        const Eigen::Vector2d blo = g.p0.cwiseMin(g.p1) - Eigen::Vector2d::Constant(g.reach) - origin;
-        const Eigen::Vector2d bhi = g.p0.cwiseMax(g.p1) + Eigen::Vector2d::Constant(g.reach) - origin;
+        const Eigen::Vector2d blo = g.p0.cwiseMin(g.p1) - Eigen::Vector2d::Constant(g.reach) - fr.origin;
+        const Eigen::Vector2d bhi = g.p0.cwiseMax(g.p1) + Eigen::Vector2d::Constant(g.reach) - fr.origin;
         Eigen::Vector2d flo(1e300, 1e300), fhi(-1e300, -1e300);
         for (const Eigen::Vector2d& c : {blo, bhi, Eigen::Vector2d(blo.x(), bhi.y()), Eigen::Vector2d(bhi.x(), blo.y())}) {
-            const Eigen::Vector2d f = Gi * c;
+            const Eigen::Vector2d f = fr.Gi * c;
             flo = flo.cwiseMin(f), fhi = fhi.cwiseMax(f);
         }
         const int x0 = static_cast<int>(std::floor(flo.x() * nx)), x1 = static_cast<int>(std::floor(fhi.x() * nx));
@@ -117,48 +134,61 @@ void NeighbourList::build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, do
                 const int wy = static_cast<int>(std::floor(static_cast<double>(cy) / ny));
                 if (!periodic && (wx != 0 || wy != 0)) continue;
                 const int ci = (cy - wy * ny) * nx + (cx - wx * nx);
-                cell[static_cast<size_t>(ci)].push_back({k, Eigen::Vector2i(wx, wy)});
-                covers[k].push_back({ci, Eigen::Vector2i(wx, wy)});
+                grid.cell[static_cast<size_t>(ci)].push_back({k, Eigen::Vector2i(wx, wy)});
+                grid.covers[k].push_back({ci, Eigen::Vector2i(wx, wy)});
             }
     }
-    // Per segment a: every b > a sharing a cell, each (b, image) tested once (a mark per b), then sorted.
+    return grid;
+}
+
+// Segment a's pairs: every b > a of another fiber sharing a cell, each (b, image) tested once (a mark per b, in
+// seen_a / seen_image), within range + skin exactly, sorted by b and image.
+void pairs_of(int a, const Model& m, const std::vector<SegInfo>& seg, const Grid& grid, const Frame& fr, double skin,
+              std::vector<int>& seen_a, std::vector<Eigen::Vector2i>& seen_image, std::vector<SegmentPair>& out) {
+    const SegInfo& A = seg[a];
+    const Segment& sa = m.segments[a];
+    for (const Entry& ca : grid.covers[a])
+        for (const Entry& eb : grid.cell[static_cast<size_t>(ca.k)]) {
+            const int b = eb.k;
+            if (b <= a || m.segments[b].fiber == sa.fiber) continue;
+            // a's copy moved by -B t_a and b's by -B t_b meet in this cell: b lies at image t_a - t_b next to a in
+            // the wrapped frames, (t_a - t_b) - wrap_b + wrap_a from a's first node.
+            const Eigen::Vector2i rel = ca.t - eb.t;
+            SegmentPair p;
+            p.a = a, p.b = b, p.image = rel - seg[b].wrap + A.wrap;
+            if (seen_a[b] == a && seen_image[b] == p.image) continue;
+            seen_a[b] = a, seen_image[b] = p.image;
+            if (touch(sa, m.segments[b], p.image)) continue;
+            const SegInfo& Bs = seg[b];
+            const Eigen::Vector2d tt = fr.G * rel.cast<double>();
+            const double cut = std::max(A.reach, Bs.reach) + 0.5 * skin;
+            if (segment_distance(A.p0, A.p1, Bs.p0 + tt, Bs.p1 + tt) >= cut) continue;
+            out.push_back(p);
+        }
+    std::sort(out.begin(), out.end(), [](const SegmentPair& p, const SegmentPair& q) {
+        if (p.b != q.b) return p.b < q.b;
+        if (p.image.x() != q.image.x()) return p.image.x() < q.image.x();
+        return p.image.y() < q.image.y();
+    });
+    out.erase(std::unique(out.begin(), out.end(),
+                          [](const SegmentPair& p, const SegmentPair& q) { return p.b == q.b && p.image == q.image; }),
+              out.end());
+}
+
+}  // namespace
+
+void NeighbourList::build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double skin) {
+    const int ns = static_cast<int>(m_.segments.size());
+    built_skin_ = std::max(skin, skin_);
+    std::vector<SegInfo> seg;
+    const Frame fr = segment_frame(m_, x, B, range_, built_skin_, seg);
+    const Grid grid = cover_cells(seg, fr, m_.box.periodic);
     std::vector<std::vector<SegmentPair>> found(ns);
-    const int threads = ns >= 2048 ? thread_count() : 1;
-    parallel_ranges(ns, threads, [&](size_t lo_k, size_t hi_k) {
+    parallel_ranges(ns, ns >= 2048 ? thread_count() : 1, [&](size_t lo, size_t hi) {
         std::vector<int> seen_a(ns, -1);
         std::vector<Eigen::Vector2i> seen_image(ns);
-        for (size_t ka = lo_k; ka < hi_k; ++ka) {
-            const int a = static_cast<int>(ka);
-            const SegInfo& A = seg[a];
-            const Segment& sa = m_.segments[a];
-            std::vector<SegmentPair>& out = found[a];
-            for (const Entry& ca : covers[a])
-                for (const Entry& eb : cell[static_cast<size_t>(ca.k)]) {
-                    const int b = eb.k;
-                    if (b <= a || m_.segments[b].fiber == sa.fiber) continue;
-                    // a's copy moved by -B t_a and b's by -B t_b meet in this cell: b lies at image t_a - t_b next to
-                    // a in the wrapped frames, (t_a - t_b) - wrap_b + wrap_a from a's first node.
-                    const Eigen::Vector2i rel = ca.t - eb.t;
-                    SegmentPair p;
-                    p.a = a, p.b = b, p.image = rel - seg[b].wrap + A.wrap;
-                    if (seen_a[b] == a && seen_image[b] == p.image) continue;
-                    seen_a[b] = a, seen_image[b] = p.image;
-                    if (touch(sa, m_.segments[b], p.image)) continue;
-                    const SegInfo& Bs = seg[b];
-                    const Eigen::Vector2d tt = G * rel.cast<double>();
-                    const double cut = std::max(A.reach, Bs.reach) + 0.5 * built_skin_;
-                    if (segment_distance(A.p0, A.p1, Bs.p0 + tt, Bs.p1 + tt) >= cut) continue;
-                    out.push_back(p);
-                }
-            std::sort(out.begin(), out.end(), [](const SegmentPair& p, const SegmentPair& q) {
-                if (p.b != q.b) return p.b < q.b;
-                if (p.image.x() != q.image.x()) return p.image.x() < q.image.x();
-                return p.image.y() < q.image.y();
-            });
-            out.erase(std::unique(out.begin(), out.end(),
-                                  [](const SegmentPair& p, const SegmentPair& q) { return p.b == q.b && p.image == q.image; }),
-                      out.end());
-        }
+        for (size_t a = lo; a < hi; ++a)
+            pairs_of(static_cast<int>(a), m_, seg, grid, fr, built_skin_, seen_a, seen_image, found[a]);
     });
     size_t total = 0;
     for (const auto& f : found) total += f.size();
