@@ -42,7 +42,8 @@ SmoothRelaxResult relax_smooth_wet(SmoothWetEnergy& W, Solver& solver, Eigen::Ve
         const bool outdated = stale || !W.pattern_current();  // a reason the solve may have been held back
         const bool rebuild = opt.always_rebuild || outdated;
         if (stale) ++R.stale_patterns;
-        if (rebuild && !R.last.converged()) {
+        const bool rebuilt = rebuild && !R.last.converged();
+        if (rebuilt) {
             const auto tl = Clock::now();
             W.rebuild(q);
             R.seconds_patterns += since(tl);
@@ -50,7 +51,7 @@ SmoothRelaxResult relax_smooth_wet(SmoothWetEnergy& W, Solver& solver, Eigen::Ve
         if (opt.progress)
             std::fprintf(stderr, "  round %d: %s, %d iterations, E = %.10g, max|g| = %.3g%s\n", R.rounds,
                          to_string(R.last.status).c_str(), R.last.iterations, R.energy, R.grad_max,
-                         rebuild ? (stale ? ", pattern rebuilt (stale)" : ", pattern rebuilt") : "");
+                         rebuilt ? (stale ? ", pattern rebuilt (stale)" : ", pattern rebuilt") : "");
         if (R.last.converged()) {
             R.converged = true;
             char m[120];
@@ -59,11 +60,10 @@ SmoothRelaxResult relax_smooth_wet(SmoothWetEnergy& W, Solver& solver, Eigen::Ve
             break;
         }
         const bool cut = R.last.status == SolveStatus::IterationLimit && cap < base.max_iter;
-        if (!R.last.converged() && !cut && !outdated) {
-            R.message = "the solver stopped on a list that covers the state: " + R.last.message;
+        if (!cut && !outdated) {  // a failure with the Hessian's pattern up to date: not the list's doing
+            R.message = "the solver stopped: " + R.last.message;
             break;
         }
-        if (R.iterations >= base.max_iter * opt.max_rounds) break;
     }
     if (!R.converged && R.message.empty()) {
         char m[160];
