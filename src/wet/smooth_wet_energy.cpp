@@ -178,9 +178,13 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
     // dry terms (evaluated beside the first chunk).
     const size_t n = on.size(), chunk = H ? std::min(n, kChunk) : n;
     const int threads = n >= 64 ? thread_count() : 1;
-    std::vector<double> cE(chunk);
-    std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>> cg(g || H ? chunk : 0);
-    std::vector<Matrix8d, Eigen::aligned_allocator<Matrix8d>> cH(H ? chunk : 0);
+    // Buffers kept between evaluations (a Hessian's chunk holds 8 MB of blocks).
+    std::vector<double>& cE = chunk_E_;
+    auto& cg = chunk_g_;
+    auto& cH = chunk_H_;
+    cE.resize(chunk);
+    if (g || H) cg.resize(chunk);
+    if (H) cH.resize(chunk);
     double E = 0;
     double* hv = nullptr;
     auto dry_terms = [&] {
@@ -188,10 +192,7 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
         E = eval_.energy;
         if (g) g->swap(eval_.gradient);
         if (H) {
-            hv = H->valuePtr();
-            std::fill(hv, hv + H->nonZeros(), 0.0);
-            const double* dv = dry_H_.valuePtr();
-            for (size_t i = 0; i < dry_slot_.size(); ++i) hv[dry_slot_[i]] += dv[i];
+            hv = assign_subpattern(dry_H_, dry_slot_, *H);
         }
     };
     if (n == 0) dry_terms();
@@ -215,7 +216,7 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
             const int pk = patterned_[k];
             if (H && pk < 0) stale_ = true;
             scatter_element(idx, H && pk >= 0 ? &slots_[64 * static_cast<size_t>(pk)] : nullptr, 8, cg[i].data(),
-                            cH.empty() ? nullptr : cH[i].data(), g, H && pk >= 0 ? hv : nullptr);
+                            H ? cH[i].data() : nullptr, g, H && pk >= 0 ? hv : nullptr);
         }
     }
     return E;

@@ -87,10 +87,7 @@ double WetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::Spar
         if (g) g->swap(eval_.gradient);
         if (H) {
             if (H->nonZeros() != hessian_pattern().nonZeros()) throw std::logic_error("Hessian lacks the wet energy's pattern");
-            hv = H->valuePtr();
-            std::fill(hv, hv + H->nonZeros(), 0.0);
-            const double* dv = dry_H_.valuePtr();
-            for (size_t i = 0; i < dry_slot_.size(); ++i) hv[dry_slot_[i]] += dv[i];
+            hv = assign_subpattern(dry_H_, dry_slot_, *H);
         }
     };
     for (size_t c0 = 0; c0 < ne; c0 += chunk) {

@@ -42,10 +42,11 @@ void shear_moduli(WetState& s, const NetworkEnergy& dry, const Eigen::Matrix2d& 
 namespace {
 // The smooth model's two shear moduli (as shear_moduli): the second difference of relaxed smooth energies at
 // gamma = +-h and the exact linear modulus of the smooth energy.
+// sp: the resolved pair parameters (widths from the model), as the relaxation had them.
 void smooth_shear_moduli(WetState& s, const NetworkEnergy& dry, const Eigen::Matrix2d& F, const FiberPairs& dry_pairs,
-                         const WetRunOptions& opt, Solver& solver) {
+                         const SmoothWetParams& sp, const SmoothRelaxOptions& ro, double h, Solver& solver) {
     double E[3];
-    const double A = std::abs((F * dry.model().box.B0()).determinant()), h = opt.modulus_strain;
+    const double A = std::abs((F * dry.model().box.B0()).determinant());
     s.shear_modulus_fd = std::numeric_limits<double>::quiet_NaN();
     bool ok = true;
     for (int k = -1; k <= 1 && ok; ++k) {
@@ -53,12 +54,12 @@ void smooth_shear_moduli(WetState& s, const NetworkEnergy& dry, const Eigen::Mat
         S(0, 1) = k * h;
         const Eigen::Matrix2d Fk = S * F;
         Eigen::VectorXd qk = dry.affine_map(s.q, F, Fk);
-        SmoothWetEnergy W(dry, Fk, opt.smooth, dry_pairs, qk);
-        ok = relax_smooth_wet(W, solver, qk, opt.smooth_relax).converged;
+        SmoothWetEnergy W(dry, Fk, sp, dry_pairs, qk);
+        ok = relax_smooth_wet(W, solver, qk, ro).converged;
         E[k + 1] = W.value(qk);
     }
     if (ok) s.shear_modulus_fd = (E[0] - 2 * E[1] + E[2]) / (A * h * h);
-    SmoothWetEnergy W(dry, F, opt.smooth, dry_pairs, s.q);
+    SmoothWetEnergy W(dry, F, sp, dry_pairs, s.q);  // its pattern fresh at s.q: every non-zero pair's block
     const Modulus M = wet_linear_moduli(W, s.q, {shear_mode(F, A)}).front();
     s.shear_modulus = M.ok ? M.value : std::numeric_limits<double>::quiet_NaN();
     s.shear_modulus_error = M.ok ? M.error : std::numeric_limits<double>::quiet_NaN();
@@ -86,13 +87,10 @@ void run_wet_smooth(WetRun& run, const Network& net, const NetworkEnergy& dry, c
     if (sp.pair.crossing_width <= 0) sp.pair.crossing_width = r;
     if (sp.pair.contact <= 0) sp.pair.contact = 2 * r;
     if (sp.pair.overlap_width <= 0) sp.pair.overlap_width = r;
-    WetRunOptions o = opt;
-    o.smooth = sp;
     run.wet.q = run.dry.q;
     SmoothWetEnergy W(dry, F, sp, dry_pairs, run.wet.q);
     run.initial_bridges = W.bridges(run.wet.q);
-    SmoothRelaxOptions ro = opt.smooth_relax;
-    run.smooth = relax_smooth_wet(W, solver, run.wet.q, ro);
+    run.smooth = relax_smooth_wet(W, solver, run.wet.q, opt.smooth_relax);
     run.seconds_wet_solve = run.smooth.seconds;
     run.active.seconds_solve = run.smooth.seconds;
     run.wet.converged = run.smooth.converged;
@@ -114,7 +112,7 @@ void run_wet_smooth(WetRun& run, const Network& net, const NetworkEnergy& dry, c
     run.seconds_pores += now() - t0;
     if (opt.moduli && run.wet.converged) {
         t0 = now();
-        smooth_shear_moduli(run.wet, dry, F, dry_pairs, o, solver);
+        smooth_shear_moduli(run.wet, dry, F, dry_pairs, sp, opt.smooth_relax, opt.modulus_strain, solver);
         run.seconds_moduli += now() - t0;
     }
     if (opt.free_box.enabled) {

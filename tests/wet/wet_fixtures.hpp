@@ -118,6 +118,20 @@ inline Network mikado(double L, double q, double pl, std::uint64_t seed) {
     return generate_mikado(p);
 }
 
+// A small random network (seed scheme, 4 segments per fiber) with every fifth node fixed (a clamp), for the
+// fixed-node terms of the strain derivatives (a fixed node sits at F x_ref); clamped_box() is a general F for it.
+inline Model clamped_network() {
+    Model m = model_of(mikado(2.5, 4, 0.5, 7), 4);
+    m.fixed.assign(m.num_nodes(), 0);
+    for (int i = 0; i < m.num_nodes(); i += 5) m.fixed[i] = 1;
+    return m;
+}
+inline Eigen::Matrix2d clamped_box() {
+    Eigen::Matrix2d F;
+    F << 1.05, 0.2, -0.1, 0.95;
+    return F;
+}
+
 // Passes each call to Newton with the options the loop set, and records them.
 class Recording : public Solver {
 public:

@@ -2,6 +2,7 @@
 // Upper-triangular CSC Hessian patterns built from elements and other patterns, and the value slots of entries: shared
 // by the energies that assemble into a fixed pattern (wet_energy.hpp, wet_region.hpp, network_energy.hpp).
 #include <Eigen/Core>
+#include <algorithm>
 #include <Eigen/SparseCore>
 #include <vector>
 
@@ -43,6 +44,17 @@ void element_slots(const Eigen::SparseMatrix<double>& P, const std::vector<int>&
 // The slot in P of every entry of a pattern S contained in P, in S's value order (one pass per column). Throws like
 // pattern_slot if P lacks one.
 std::vector<int> subpattern_slots(const Eigen::SparseMatrix<double>& P, const Eigen::SparseMatrix<double>& S);
+
+// The values of H (a pattern containing S's) set to S's, through S's slots in H (subpattern_slots), zero elsewhere:
+// the dry Hessian as the first part of a wet one. Returns H's values for the elements to add to.
+inline double* assign_subpattern(const Eigen::SparseMatrix<double>& S, const std::vector<int>& slots,
+                                 Eigen::SparseMatrix<double>& H) {
+    double* hv = H.valuePtr();
+    std::fill(hv, hv + H.nonZeros(), 0.0);
+    const double* sv = S.valuePtr();
+    for (size_t i = 0; i < slots.size(); ++i) hv[slots[i]] += sv[i];
+    return hv;
+}
 
 // Adds one element's gradient ge (M local coordinates) to g and its Hessian block he (M x M, column-major) to the
 // values hv, through the element's index table idx (-1: a held coordinate) and slot table (element_slots; -1: not

@@ -38,7 +38,6 @@ public:
     const std::vector<SegmentPair>& pairs() const { return pairs_; }
     int builds() const { return builds_; }
     double skin() const { return skin_; }
-    double built_skin() const { return built_skin_; }
 
     // Local coordinates (p0, p1, q0, q1) of pair k at positions x in box B.
     Eigen::Matrix<double, 8, 1> coordinates(const SegmentPair& p, const Eigen::VectorXd& x,

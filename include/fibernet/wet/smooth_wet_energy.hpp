@@ -65,8 +65,6 @@ public:
     bool pattern_stale() const { return stale_; }
     int list_builds() const { return list_.builds(); }
     int pattern_builds() const { return pattern_builds_; }
-    size_t listed_pairs() const { return list_.pairs().size(); }
-    size_t patterned_pairs() const { return n_patterned_; }
 
     void strain_derivatives(const Eigen::VectorXd& q, const Eigen::Matrix2d& dF, EnergyEval& out,
                             bool comoving = false) const override;
@@ -118,6 +116,10 @@ private:
     size_t n_patterned_ = 0;
     bool stale_ = false;
     EnergyEval eval_;
+    // Per-chunk pair results (eval), kept between evaluations.
+    std::vector<double> chunk_E_;
+    std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>> chunk_g_;
+    std::vector<Matrix8d, Eigen::aligned_allocator<Matrix8d>> chunk_H_;
     std::vector<int> seg_fiber_, seg_index_;  // per segment: fiber and index in its chain
 };
 
