@@ -14,7 +14,9 @@ Pore measures (areas in seed units^2; the fiber length is 10 seed units on the s
   count, mean area, area-weighted mean area sum(A^2)/sum(A) (the size of the pore that a random point of the open
   area lies in: it is not pulled down by the slivers that zipping leaves between aligned fibers, which the plain mean
   counts as pores), d50 (the equivalent diameter sqrt(4A/pi) that splits the pore area in halves: half of it lies in
-  pores at least that wide) and the largest pore's area.
+  pores at least that wide) and the largest pore's area. From summary.json's pores block (fibernet since issue 22;
+  blank for older runs): the fractions of the box in walls (slivers inside bundles), faces with islands and open
+  faces, and the cover (pores + those over the box area).
 Usage: plot_wet_pores.py OUT
 """
 import csv
@@ -42,6 +44,14 @@ def pore_measures(areas):
             "d50": d50, "largest_area": areas[-1]}
 
 
+def face_classes(p):  # the box's non-pore faces and the cover, as fractions of the box (blank before issue 22)
+    if "cover" not in p:
+        return {"wall_fraction": "", "island_fraction": "", "open_fraction": "", "cover": ""}
+    a = p["box_area"]
+    return {"wall_fraction": p["wall_area"] / a, "island_fraction": p["island_area"] / a,
+            "open_fraction": p["open_area"] / a, "cover": p["cover"]}
+
+
 def read_seed(d, study):
     seed = int(os.path.basename(d)[len("seed"):])
     with open(os.path.join(d, "summary.json")) as f:
@@ -67,7 +77,7 @@ def read_seed(d, study):
                          "bundled_fraction": "", "largest_bundle": "", "bundle_partners": "", "capped": "",
                          "E_capillary": 0.0, "seconds": "",
                          "E_bend": run["energy"]["dry"]["bend"], "G": run["shear_modulus"]["dry"],
-                         **pore_measures(areas.get("dry", []))})
+                         **pore_measures(areas.get("dry", [])), **face_classes(run["pores"]["dry"])})
         beta = run["beta"]
         rows.append({"seed": seed, "beta": beta, "status": run["status"], "fibers": fibers, "pl": pl,
                      "bridges": run["bridges"]["final"],
@@ -77,7 +87,7 @@ def read_seed(d, study):
                      "seconds": run["seconds"]["wet_solve"] + run["seconds"]["events"],
                      "E_capillary": run["energy"]["wet"]["capillary"],
                      "E_bend": run["energy"]["wet"]["bend"], "G": run["shear_modulus"]["wet"],
-                     **pore_measures(areas.get(float(beta), []))})
+                     **pore_measures(areas.get(float(beta), [])), **face_classes(run["pores"]["wet"])})
     return summary.get("complete", False), rows
 
 
@@ -96,7 +106,8 @@ def main(out):
         sys.exit(f"plot_wet_pores.py: no seed*/summary.json under {out}")
     cols = ["seed", "beta", "status", "fibers", "pl", "bridges", "bundled_fraction", "largest_bundle", "bundle_partners",
             "capped", "E_capillary", "seconds",
-            "E_bend", "G", "pores", "mean_area", "weighted_area", "d50", "largest_area"]
+            "E_bend", "G", "pores", "mean_area", "weighted_area", "d50", "largest_area", "wall_fraction",
+            "island_fraction", "open_fraction", "cover"]
     with open(os.path.join(out, "runs.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=cols)
         w.writeheader()
@@ -109,7 +120,9 @@ def main(out):
                 ("capped", "capped (bundle_partners)", "{:.0f}"), ("E_capillary", "E_capillary", "{:.3g}"),
                 ("G", "G", "{:.3g}"), ("pores", "pores", "{:.0f}"), ("mean_area", "mean area", "{:.2f}"),
                 ("weighted_area", "area-weighted mean area", "{:.1f}"), ("d50", "d50", "{:.2f}"),
-                ("largest_area", "largest pore", "{:.0f}"), ("seconds", "wet solve + events, s", "{:.1f}")]
+                ("largest_area", "largest pore", "{:.0f}"), ("wall_fraction", "walls (box fraction)", "{:.3f}"),
+                ("island_fraction", "island faces", "{:.3f}"), ("open_fraction", "open faces", "{:.3f}"),
+                ("cover", "cover", "{:.4f}"), ("seconds", "wet solve + events, s", "{:.1f}")]
 
     def stat(key, m):
         v = [r[m] for r in rows if r["beta"] == key and r["status"] in ("dry", "stable") and r[m] != ""]

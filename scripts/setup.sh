@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 pkgs=(build-essential cmake pkg-config libeigen3-dev libsuitesparse-dev libopenblas-dev
-      libnlopt-cxx-dev coinor-libipopt-dev catch2 libcli11-dev nlohmann-json3-dev libtomlplusplus-dev
+      libnlopt-cxx-dev coinor-libipopt-dev catch2 libcli11-dev nlohmann-json3-dev libtomlplusplus-dev libcgal-dev
       openmpi-bin libopenmpi-dev python3-matplotlib  # MPI: fibernet scan; matplotlib: the plot scripts
       pybind11-dev python3-dev python3-numpy)          # the Python package (docs/python.md)
 # The test suite also runs LAMMPS and VTK on fibernet's exports, and pytest on the Python package.

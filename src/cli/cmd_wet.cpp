@@ -155,8 +155,10 @@ nlohmann::json pore_json(const PoreStats& p) {
     const double n = static_cast<double>(p.pores.size());
     return {{"count", p.pores.size()}, {"mean_area", n ? num(sum / n) : nlohmann::json()},
             {"mean_diameter", n ? num(dsum / n) : nlohmann::json()}, {"largest_area", amax},
-            {"remainder_area", p.remainder}, {"box_area", p.box_area}, {"open_cycles", p.open_cycles},
-            {"islands", p.islands}};
+            {"remainder_area", p.remainder}, {"box_area", p.box_area}, {"wall_width", p.wall_width},
+            {"walls", p.walls}, {"wall_area", p.wall_area}, {"island_faces", p.island_faces},
+            {"island_area", p.island_area}, {"islands", p.islands}, {"open_faces", p.open_faces},
+            {"open_area", p.open_area}, {"cover", p.cover()}};
 }
 
 nlohmann::json energy_json(const WetSplit& e) {

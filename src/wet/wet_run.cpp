@@ -18,6 +18,10 @@ namespace {
 double now() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
+// Faces narrower than the contact distance are walls, not pores, in either model (pores.hpp).
+double wall_width(const WetRunOptions& opt, const Model& m) {
+    return opt.smooth.pair.contact > 0 ? opt.smooth.pair.contact : default_wall_width(m);
+}
 }  // namespace
 
 namespace {
@@ -107,7 +111,7 @@ void run_wet_smooth(WetRun& run, const Network& net, const NetworkEnergy& dry, c
     run.wet.energy.capillary = split.capillary();
     double t0 = now();
     const Eigen::VectorXd x = dry.positions(run.wet.q, F);
-    run.wet.pores = pores(m, x, B);
+    run.wet.pores = pores(m, x, B, wall_width(opt, m));
     run.bundles = bundles(m, x, B, run.active.bridges, opt.bundle_angle_deg);
     run.seconds_pores += now() - t0;
     if (opt.moduli && run.wet.converged) {
@@ -186,7 +190,7 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
         run.dry.energy = D.split(run.dry.q);
         run.seconds_dry = now() - t0;
         t0 = now();
-        run.dry.pores = pores(m, dry.positions(run.dry.q, F), B);
+        run.dry.pores = pores(m, dry.positions(run.dry.q, F), B, wall_width(opt, m));
         run.seconds_pores += now() - t0;
         if (opt.moduli && run.dry.converged) {
             t0 = now();
@@ -219,7 +223,7 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     run.wet.energy = WetEnergy(dry, F, run.active.bridges, opt.params).split(run.wet.q);
     t0 = now();
     const Eigen::VectorXd x = dry.positions(run.wet.q, F);
-    run.wet.pores = pores(m, x, B);
+    run.wet.pores = pores(m, x, B, wall_width(opt, m));
     run.bundles = bundles(m, x, B, run.active.bridges, opt.bundle_angle_deg);
     run.seconds_pores += now() - t0;
     if (opt.moduli && run.wet.converged && run.active.stable) {  // the moduli of a consistent bridge set only
@@ -233,7 +237,7 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
                                     opt.free_box);
             const Eigen::Matrix2d Bf = run.free_box.F * m.box.B0();
             const Eigen::VectorXd xf = dry.positions(run.free_box.q, run.free_box.F);
-            run.free_box.pores = pores(m, xf, Bf);
+            run.free_box.pores = pores(m, xf, Bf, wall_width(opt, m));
             run.free_box.bundles = bundles(m, xf, Bf, run.free_box.bridges, opt.bundle_angle_deg);
             if (opt.moduli) {
                 t0 = now();

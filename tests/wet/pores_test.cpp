@@ -33,7 +33,7 @@ TEST_CASE("pores: a periodic square grid has exactly its cells", "[wet][pores]")
         std::sort(got.begin(), got.end()), std::sort(want.begin(), want.end());
         for (size_t i = 0; i < 9; ++i) CHECK(got[i] == Approx(want[i]).epsilon(1e-10));
         CHECK(std::abs(p.remainder) < 1e-9 * p.box_area);
-        CHECK(p.open_cycles == 0);
+        CHECK(p.open_faces == 0);
         CHECK(p.pores[0].diameter == Approx(std::sqrt(4 * p.pores[0].area / M_PI)));
     }
 }
@@ -99,8 +99,11 @@ TEST_CASE("pores: a face with an island inside is not a disk", "[wet][pores]") {
         REQUIRE(p.pores.size() == 1);
         CHECK(p.pores[0].area == Approx(tri).epsilon(1e-10));
         CHECK(p.islands == 1);
-        CHECK(p.open_cycles == 0);
+        CHECK(p.island_faces == 1);
+        // On the torus the face outside the square winds around it: the void percolates.
+        CHECK(p.open_faces == (periodic ? 1 : 0));
         CHECK(p.remainder == Approx(p.box_area - tri).epsilon(1e-12));
+        if (periodic) CHECK(p.cover() == Approx(1).epsilon(1e-12));
     }
 }
 
@@ -136,12 +139,31 @@ TEST_CASE("pores: two fibers zipped on top of each other across a square", "[wet
         const Model m = model_of(network_of(lines, 3.0, periodic), 10);
         const PoreStats p = pores(m, m.x, m.box.B0());
         INFO("periodic " << periodic);
-        CHECK(p.open_cycles == 0);
+        CHECK(p.open_faces == (periodic ? 1 : 0));
         REQUIRE(p.pores.size() == 2);
         CHECK(p.pores[0].area == Approx(14.58).epsilon(1e-9));
         CHECK(p.pores[1].area == Approx(14.58).epsilon(1e-9));
         CHECK(p.remainder == Approx(p.box_area - 29.16).epsilon(1e-12));
     }
+}
+
+TEST_CASE("pores: slivers between two fibers at 1 deg are walls, not pores", "[wet][pores]") {
+    // Two fibers crossing at the square's centre at 30 and 31 deg: two wide faces and two slivers about 0.03 wide
+    // (seed units) along them, below the default wall width 2/a = 0.2. With a wall width below that they are pores.
+    std::vector<Line> lines = square(1.5, 0.27);
+    lines.push_back({1.5, 1.5, 30, 1, 0.5});
+    lines.push_back({1.5, 1.5, 31, 1, 0.5});
+    const Model m = model_of(network_of(lines, 3.0, false), 10);
+    const PoreStats p = pores(m, m.x, m.box.B0());
+    CHECK(p.wall_width == Approx(0.2));
+    CHECK(p.pores.size() == 2);
+    CHECK(p.walls == 2);
+    double sum = p.wall_area;
+    for (const auto& q : p.pores) sum += q.area;
+    CHECK(sum == Approx(100 * 0.54 * 0.54).epsilon(1e-12));
+    const PoreStats fine = pores(m, m.x, m.box.B0(), 0.01);
+    CHECK(fine.pores.size() == 4);
+    CHECK(fine.walls == 0);
 }
 
 TEST_CASE("pores: zipped fiber pairs in a Mikado network leave no area out", "[wet][pores]") {
@@ -162,6 +184,66 @@ TEST_CASE("pores: zipped fiber pairs in a Mikado network leave no area out", "[w
     net.crossings = find_crossings(net);
     const Model m = model_of(net, 10);
     const PoreStats p = pores(m, m.x, m.box.B0());
-    CHECK(p.open_cycles == 0);
-    CHECK(std::abs(p.remainder) < 1e-9 * p.box_area);
+    CHECK(p.open_faces == 0);
+    CHECK(p.cover() == Approx(1).epsilon(1e-12));
+}
+
+TEST_CASE("pores: faces that wind around the torus are open, not pores", "[wet][pores]") {
+    // Two horizontal fibers closing on themselves: the box is two bands, each winding around the torus. A single
+    // free fiber crossing nothing is pruned: the one face left is the whole torus.
+    const Model bands = model_of(network_of({{0.05, 0.3, 0, 1, 0}, {0.05, 0.7, 0, 1, 0}}, 1.0), 10);
+    const PoreStats p = pores(bands, bands.x, bands.box.B0());
+    CHECK(p.pores.empty());
+    CHECK(p.open_faces == 2);
+    CHECK(p.open_area == Approx(p.box_area).epsilon(1e-12));
+    CHECK(p.cover() == Approx(1).epsilon(1e-12));
+    const Model lone = model_of(network_of({{0.98, 0.5, 20, 0.3, 0.5}}, 1.0), 10);  // across the cut
+    const PoreStats q = pores(lone, lone.x, lone.box.B0());
+    CHECK(q.pores.empty());
+    CHECK(q.open_faces == 1);
+    CHECK(q.island_faces == 0);
+    CHECK(q.open_area == Approx(q.box_area).epsilon(1e-12));
+}
+
+TEST_CASE("pores: the grid's cells with fibers on the cut lines, dangling ends across them and shear",
+          "[wet][pores]") {
+    // A vertical fiber exactly on x = 0 (the natural cut line), a free fiber and a dangling end across the cut, in a
+    // sheared box: still exactly the nine cells, with the same areas (det F = 1).
+    const std::vector<double> ys = {0.14, 0.41, 0.77}, xs = {0.0, 0.5, 0.9};
+    std::vector<Line> lines;
+    for (double y : ys) lines.push_back({0.05, y, 0, 1, 0});
+    for (double x : xs) lines.push_back({x, 0.03, 90, 1, 0});
+    lines.push_back({0.38, 0.3, 15, 0.12, 0.5});  // free, across the cut x = 0.38 (moved off x = 0) in [0, 0.5] x [0.14, 0.41]
+    lines.push_back({0.7, 0.999, 70, 0.1, 0.5});  // free, across y = 1 ~ 0 inside [0.5, 0.9] x [0.77, 1.14]
+    lines.push_back({0.3, 0.5, 85, 0.5, 0.5});    // dangling: crosses y = 0.41 and 0.77 only
+    const Model m = model_of(network_of(lines, 1.0), 10);
+    Eigen::Matrix2d F;
+    F << 1, 0.4, 0, 1;
+    Eigen::VectorXd x(m.x.size());
+    for (int i = 0; i < m.num_nodes(); ++i) x.segment<2>(2 * i) = F * m.x.segment<2>(2 * i);
+    const PoreStats p = pores(m, x, F * m.box.B0());
+    std::vector<double> got, want;
+    for (const auto& q : p.pores) got.push_back(q.area);
+    for (double a : {0.5, 0.4, 0.1})
+        for (double b : {0.27, 0.36, 0.37}) want.push_back(100 * a * b);
+    std::sort(got.begin(), got.end()), std::sort(want.begin(), want.end());
+    REQUIRE(got.size() == 9);
+    for (size_t i = 0; i < 9; ++i) CHECK(got[i] == Approx(want[i]).epsilon(1e-10));
+    CHECK(p.open_faces + p.island_faces + p.walls == 0);
+}
+
+TEST_CASE("pores: a sheared Mikado network is tiled exactly", "[wet][pores]") {
+    // Every face classified, on the torus: the classes sum to the box area to round-off, at any shear.
+    const Model m = model_of(mikado(4, 8, 0.5, 5), 6);
+    for (double shear : {0.0, 0.25, -0.6}) {
+        Eigen::Matrix2d F;
+        F << 1, shear, 0, 1;
+        Eigen::VectorXd x(m.x.size());
+        for (int i = 0; i < m.num_nodes(); ++i) x.segment<2>(2 * i) = F * m.x.segment<2>(2 * i);
+        const PoreStats p = pores(m, x, F * m.box.B0());
+        INFO("shear " << shear);
+        CHECK(p.cover() == Approx(1).epsilon(1e-12));
+        CHECK(p.pores.size() > 10);
+        CHECK(p.remainder == Approx(p.wall_area + p.island_area + p.open_area).margin(1e-9 * p.box_area));
+    }
 }
