@@ -1,110 +1,26 @@
 #include "fibernet/energy/network_energy.hpp"
 #include "fibernet/energy/network_region.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <stdexcept>
 #include <string>
 
 #include "fibernet/energy/bend.hpp"
-#include "fibernet/energy/sparse_pattern.hpp"
 
 namespace fibernet {
-
-namespace {
-// Local upper-triangular pairs (a <= b) of an m x m element block, in row-major order.
-template <int M>
-constexpr int n_upper() { return M * (M + 1) / 2; }
-
-// Slots for an element on nodes[0..K-1] (2K local coordinates), packed upper triangle (a <= b) in row order; unlike
-// fibernet::element_slots (sparse_pattern.hpp), which fills full M x M blocks for the wet energies.
-template <int K>
-void packed_slots(const int* nodes, const std::vector<int>& dof, const Eigen::SparseMatrix<double>& P, int* out) {
-    for (int a = 0; a < K; ++a)
-        for (int b = a + 1; b < K; ++b)
-            if (nodes[a] == nodes[b]) throw std::logic_error("an element uses one node twice");
-    int s = 0;
-    for (int a = 0; a < 2 * K; ++a)
-        for (int b = a; b < 2 * K; ++b) {
-            const int r = dof[2 * nodes[a / 2] + a % 2], c = dof[2 * nodes[b / 2] + b % 2];
-            out[s++] = (r < 0 || c < 0) ? -1 : pattern_slot(P, std::min(r, c), std::max(r, c));
-        }
-}
-
-template <int M>
-void scatter(const Eigen::Matrix<double, M, M>& h, const int* slots, double* values) {
-    int s = 0;
-    for (int a = 0; a < M; ++a)
-        for (int b = a; b < M; ++b, ++s)
-            if (slots[s] >= 0) values[slots[s]] += h(a, b);
-}
-
-template <int M>
-Eigen::Matrix<double, M, M> project_psd(const Eigen::Matrix<double, M, M>& h) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, M, M>> es(h);
-    Eigen::Matrix<double, M, 1> ev = es.eigenvalues().cwiseMax(0.0);
-    return es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
-}
-}  // namespace
 
 NetworkEnergy::NetworkEnergy(const Model& model, EnergyParams params) : model_(model), params_(params) {
     const int n = model.num_nodes();
     dof_.assign(2 * n, -1);
     for (int i = 0; i < n; ++i)
         if (model.fixed.empty() || !model.fixed[i]) dof_[2 * i] = ndof_++, dof_[2 * i + 1] = ndof_++;
-
-    // Node adjacency (pairs sharing an element), then the coordinate-level upper pattern column by column.
-    std::vector<std::vector<int>> adj(n);
-    auto link = [&](int i, int j) {
-        adj[std::max(i, j)].push_back(std::min(i, j));  // column node keeps lower-numbered neighbours
-    };
-    for (int i = 0; i < n; ++i) adj[i].push_back(i);
-    for (const auto& s : model.segments) link(s.i, s.j);
-    for (const auto& h : model.hinges) link(h.i, h.j), link(h.j, h.k), link(h.i, h.k);
-    std::vector<int> outer(ndof_ + 1, 0), inner;
-    for (int J = 0; J < n; ++J) {
-        auto& a = adj[J];
-        std::sort(a.begin(), a.end());
-        a.erase(std::unique(a.begin(), a.end()), a.end());
-        for (int cj = 0; cj < 2; ++cj) {
-            const int col = dof_[2 * J + cj];
-            if (col < 0) continue;
-            for (int I : a)
-                for (int ci = 0; ci < 2; ++ci) {
-                    const int row = dof_[2 * I + ci];
-                    if (row >= 0 && row <= col) inner.push_back(row);
-                }
-            outer[col + 1] = static_cast<int>(inner.size());
-        }
-    }
-    std::vector<double> zeros(inner.size(), 0.0);
-    pattern_ = Eigen::Map<const Eigen::SparseMatrix<double>>(ndof_, ndof_, static_cast<Eigen::Index>(inner.size()),
-                                                            outer.data(), inner.data(), zeros.data());
-    pattern_.makeCompressed();
-
-    // Rest vectors: exact ones from the discretization, else from the reference positions.
-    const Eigen::Matrix2d B0 = model.box.B0();
-    auto rest = [&](const Eigen::Vector2d& given, int i, int j, const Eigen::Vector2i& n) -> Eigen::Vector2d {
-        if (given.allFinite()) return given;
-        return model.x.segment<2>(2 * j) - model.x.segment<2>(2 * i) + B0 * n.cast<double>();
-    };
-    for (const auto& s : model.segments) seg_d0_.push_back(rest(s.d0, s.i, s.j, s.shift));
-    for (const auto& h : model.hinges) {
-        hinge_d0_.push_back(rest(h.d10, h.i, h.j, h.shift1));
-        hinge_d0_.push_back(rest(h.d20, h.j, h.k, h.shift2));
-    }
-
-    seg_slots_.resize(n_upper<4>() * model.segments.size());
-    for (size_t e = 0; e < model.segments.size(); ++e) {
-        const int nodes[2] = {model.segments[e].i, model.segments[e].j};
-        packed_slots<2>(nodes, dof_, pattern_, &seg_slots_[n_upper<4>() * e]);
-    }
-    hinge_slots_.resize(n_upper<6>() * model.hinges.size());
-    for (size_t e = 0; e < model.hinges.size(); ++e) {
-        const int nodes[3] = {model.hinges[e].i, model.hinges[e].j, model.hinges[e].k};
-        packed_slots<3>(nodes, dof_, pattern_, &hinge_slots_[n_upper<6>() * e]);
-    }
+    stretch_ = std::make_unique<StretchTerm>(model, params.stretch);
+    bend_ = std::make_unique<BendTerm>(model);
+    assembly_ = std::make_unique<ElementAssembly>(std::vector<const ElementTerm*>{stretch_.get(), bend_.get()}, dof_,
+                                                  ndof_);
 }
+
+std::vector<std::string> NetworkEnergy::term_names() const { return {stretch_->name(), bend_->name()}; }
 
 Eigen::VectorXd NetworkEnergy::dofs(const Eigen::VectorXd& x) const {
     Eigen::VectorXd q(ndof_);
@@ -173,148 +89,46 @@ void NetworkEnergy::displacement_of(int i, const Eigen::VectorXd& q, const Eigen
 
 double NetworkEnergy::segment_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F, Eigen::Vector4d* g,
                                    Eigen::Matrix4d* H, bool psd) const {
-    const Segment& s = model_.segments[e];
-    const Eigen::Matrix2d FmIB0 = (F - Eigen::Matrix2d::Identity()) * model_.box.B0();
-    const Eigen::Vector2d d = seg_d0_[e] + FmIB0 * s.shift.cast<double>() + (u.segment<2>(2 * s.j) - u.segment<2>(2 * s.i));
-    Eigen::Vector2d gd;
-    Eigen::Matrix2d Hd;
-    const double E = stretch_energy(d, s.l0, 4 * model_.aspect_ratio * model_.aspect_ratio, params_.stretch,
-                                    g ? &gd : nullptr, H ? &Hd : nullptr);
-    if (g) *g << -gd, gd;
-    if (H) {
-        const Eigen::Matrix2d h = psd ? project_psd<2>(Hd) : Hd;
-        *H << h, -h, -h, h;
-    }
-    return E;
+    const ElementFrame frame(model_, dof_, u, F, Eigen::Matrix2d::Zero(), false, false);
+    ElementWant want;
+    want.gradient = g, want.hessian = H, want.psd = psd;
+    ElementResult r;
+    stretch_->evaluate(e, frame, want, r);
+    if (g) *g = r.gradient.head<4>();
+    if (H) *H = r.hessian.topLeftCorner<4, 4>();
+    return r.energy;
 }
 
 double NetworkEnergy::hinge_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F,
                                  Eigen::Matrix<double, 6, 1>* g, Eigen::Matrix<double, 6, 6>* H, bool psd) const {
-    const Hinge& h = model_.hinges[e];
-    const Eigen::Matrix2d FmIB0 = (F - Eigen::Matrix2d::Identity()) * model_.box.B0();
-    const Eigen::Vector2d d1 = hinge_d0_[2 * e] + FmIB0 * h.shift1.cast<double>() + (u.segment<2>(2 * h.j) - u.segment<2>(2 * h.i));
-    const Eigen::Vector2d d2 = hinge_d0_[2 * e + 1] + FmIB0 * h.shift2.cast<double>() + (u.segment<2>(2 * h.k) - u.segment<2>(2 * h.j));
-    Eigen::Vector4d g4;
-    Eigen::Matrix4d H4;
-    const double E = bend_energy(d1, d2, h.lt0, g ? &g4 : nullptr, H ? &H4 : nullptr);
-    // d1 = x_j - x_i, d2 = x_k - x_j (+ images).
-    if (g) *g << -g4.head<2>(), g4.head<2>() - g4.tail<2>(), g4.tail<2>();
-    if (H) {
-        Eigen::Matrix<double, 4, 6> A = Eigen::Matrix<double, 4, 6>::Zero();
-        A.block<2, 2>(0, 0) = -Eigen::Matrix2d::Identity();
-        A.block<2, 2>(0, 2) = Eigen::Matrix2d::Identity();
-        A.block<2, 2>(2, 2) = -Eigen::Matrix2d::Identity();
-        A.block<2, 2>(2, 4) = Eigen::Matrix2d::Identity();
-        const Eigen::Matrix4d hp = psd ? project_psd<4>(H4) : H4;
-        *H = A.transpose() * hp * A;
-    }
-    return E;
+    const ElementFrame frame(model_, dof_, u, F, Eigen::Matrix2d::Zero(), false, false);
+    ElementWant want;
+    want.gradient = g, want.hessian = H, want.psd = psd;
+    ElementResult r;
+    bend_->evaluate(e, frame, want, r);
+    if (g) *g = r.gradient.head<6>();
+    if (H) *H = r.hessian.topLeftCorner<6, 6>();
+    return r.energy;
 }
 
 void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F, const Eigen::Matrix2d& dF,
                              unsigned want, EnergyEval& out, Eigen::SparseMatrix<double>* H) const {
-    const bool wg = want & kGradient, wh = want & kHessian, ws = want & kStrain, psd = want & kProjectPSD;
-    const bool comoving = ws && (want & kComoving);
-    const Eigen::Matrix2d V = comoving ? Eigen::Matrix2d(dF * F.inverse()) : Eigen::Matrix2d::Zero();
-    const Eigen::VectorXd u = displacements(q, F);
-    const Eigen::Matrix2d FmI = F - Eigen::Matrix2d::Identity();
-    const Eigen::Matrix2d dB = dF * model_.box.B0(), FmIB0 = FmI * model_.box.B0();
-    const double k4a2 = 4 * model_.aspect_ratio * model_.aspect_ratio;
-    const bool any_fixed = ndof_ != static_cast<int>(dof_.size());
-    out.energy = out.stretch = out.bend = 0;
-    out.dE_dt = out.d2E_dt2 = out.d2E_dt2_size = 0;
-    if (wg) out.gradient.setZero(ndof_);
-    if (ws) out.d2E_dqdt.setZero(ndof_);
+    ElementWant w;
+    w.gradient = want & kGradient, w.hessian = want & kHessian, w.strain = want & kStrain, w.psd = want & kProjectPSD;
     double* hv = nullptr;
-    if (wh) {
-        if (!H || H->nonZeros() != pattern_.nonZeros()) throw std::logic_error("Hessian lacks the energy's pattern");
+    if (w.hessian) {
+        if (!H || H->nonZeros() != hessian_pattern().nonZeros())
+            throw std::logic_error("Hessian lacks the energy's pattern");
         hv = H->valuePtr();
-        std::fill(hv, hv + H->nonZeros(), 0.0);
     }
-    auto add_grad = [&](Eigen::VectorXd& v, int node, const Eigen::Vector2d& g) {
-        const int d0 = dof_[2 * node];
-        if (d0 >= 0) v[d0] += g.x(), v[d0 + 1] += g.y();
-    };
-    // Edge vector d = d0 + (F - I) B0 n + u_j - u_i (= x_j - x_i + F B0 n) and its strain rate
-    // dd/dt = dF (B0 n + [fixed] x_ref differences), or dF F^-1 d when every node moves affinely (kComoving).
-    auto edge = [&](int i, int j, const Eigen::Vector2i& n, const Eigen::Vector2d& d0, Eigen::Vector2d& d,
-                    Eigen::Vector2d& c) {
-        d = d0 + FmIB0 * n.cast<double>() + (u.segment<2>(2 * j) - u.segment<2>(2 * i));
-        if (!ws) return;
-        if (comoving) {
-            c = V * d;
-            return;
-        }
-        c = dB * n.cast<double>();
-        if (any_fixed) {
-            if (dof_[2 * j] < 0) c += dF * model_.x.segment<2>(2 * j);
-            if (dof_[2 * i] < 0) c -= dF * model_.x.segment<2>(2 * i);
-        }
-    };
-
-    Eigen::Vector2d d, c, gd;
-    Eigen::Matrix2d Hd;
-    for (size_t e = 0; e < model_.segments.size(); ++e) {
-        const Segment& s = model_.segments[e];
-        edge(s.i, s.j, s.shift, seg_d0_[e], d, c);
-        const double E = stretch_energy(d, s.l0, k4a2, params_.stretch, (wg || ws) ? &gd : nullptr,
-                                        (wh || ws) ? &Hd : nullptr);
-        out.stretch += E;
-        if (wg) add_grad(out.gradient, s.i, -gd), add_grad(out.gradient, s.j, gd);
-        if (ws) {
-            out.dE_dt += gd.dot(c);
-            const double tt = c.dot(Hd * c);
-            out.d2E_dt2 += tt;
-            out.d2E_dt2_size += std::abs(tt);
-            const Eigen::Vector2d hc = Hd * c;
-            add_grad(out.d2E_dqdt, s.i, -hc), add_grad(out.d2E_dqdt, s.j, hc);
-        }
-        if (wh) {
-            const Eigen::Matrix2d h = psd ? project_psd<2>(Hd) : Hd;
-            Eigen::Matrix4d hl;
-            hl << h, -h, -h, h;
-            scatter<4>(hl, &seg_slots_[n_upper<4>() * e], hv);
-        }
-    }
-
-    Eigen::Vector2d d1, d2, c1, c2;
-    Eigen::Vector4d g4;
-    Eigen::Matrix4d H4;
-    Eigen::Matrix<double, 4, 6> A = Eigen::Matrix<double, 4, 6>::Zero();
-    A.block<2, 2>(0, 0) = -Eigen::Matrix2d::Identity();
-    A.block<2, 2>(0, 2) = Eigen::Matrix2d::Identity();
-    A.block<2, 2>(2, 2) = -Eigen::Matrix2d::Identity();
-    A.block<2, 2>(2, 4) = Eigen::Matrix2d::Identity();
-    for (size_t e = 0; e < model_.hinges.size(); ++e) {
-        const Hinge& h = model_.hinges[e];
-        edge(h.i, h.j, h.shift1, hinge_d0_[2 * e], d1, c1);
-        edge(h.j, h.k, h.shift2, hinge_d0_[2 * e + 1], d2, c2);
-        const double E = bend_energy(d1, d2, h.lt0, (wg || ws) ? &g4 : nullptr, (wh || ws) ? &H4 : nullptr);
-        out.bend += E;
-        if (wg) {
-            add_grad(out.gradient, h.i, -g4.head<2>());
-            add_grad(out.gradient, h.j, g4.head<2>() - g4.tail<2>());
-            add_grad(out.gradient, h.k, g4.tail<2>());
-        }
-        if (ws) {
-            Eigen::Vector4d c4;
-            c4 << c1, c2;
-            out.dE_dt += g4.dot(c4);
-            const double tt = c4.dot(H4 * c4);
-            out.d2E_dt2 += tt;
-            out.d2E_dt2_size += std::abs(tt);
-            const Eigen::Vector4d hc = H4 * c4;
-            add_grad(out.d2E_dqdt, h.i, -hc.head<2>());
-            add_grad(out.d2E_dqdt, h.j, hc.head<2>() - hc.tail<2>());
-            add_grad(out.d2E_dqdt, h.k, hc.tail<2>());
-        }
-        if (wh) {
-            const Eigen::Matrix4d hp = psd ? project_psd<4>(H4) : H4;
-            const Eigen::Matrix<double, 6, 6> hl = A.transpose() * hp * A;
-            scatter<6>(hl, &hinge_slots_[n_upper<6>() * e], hv);
-        }
-    }
+    const Eigen::VectorXd u = displacements(q, F);
+    const ElementFrame frame(model_, dof_, u, F, dF, w.strain, want & kComoving);
+    ElementAssembly::Sums sums;
+    assembly_->assemble(frame, w, sums, w.gradient ? &out.gradient : nullptr, w.strain ? &out.d2E_dqdt : nullptr, hv);
+    out.terms = sums.energy;
+    out.stretch = sums.energy[0], out.bend = sums.energy[1];
     out.energy = out.stretch + out.bend;
+    out.dE_dt = sums.dE_dt, out.d2E_dt2 = sums.d2E_dt2, out.d2E_dt2_size = sums.d2E_dt2_size;
 }
 
 std::unique_ptr<Objective> StrainedEnergy::restriction(const Eigen::VectorXd& q, const std::vector<int>& coords) {

@@ -41,4 +41,35 @@ double stretch_energy(const Eigen::Vector2d& d, double l0, double k, const Stret
     return E;
 }
 
+StretchTerm::StretchTerm(const Model& m, StretchLaw law)
+    : m_(m), law_(law), k_(4 * m.aspect_ratio * m.aspect_ratio) {
+    d0_.reserve(m.segments.size());
+    for (const Segment& s : m.segments) d0_.push_back(rest_vector(m, s.d0, s.i, s.j, s.shift));
+}
+
+void StretchTerm::nodes(std::size_t e, int* out) const { out[0] = m_.segments[e].i, out[1] = m_.segments[e].j; }
+
+void StretchTerm::evaluate(std::size_t e, const ElementFrame& frame, const ElementWant& want,
+                           ElementResult& out) const {
+    const Segment& s = m_.segments[e];
+    Eigen::Vector2d d, c, gd;
+    Eigen::Matrix2d Hd;
+    frame.edge(s.i, s.j, s.shift, d0_[e], d, c);
+    const bool g = want.gradient || want.strain, h = want.hessian || want.strain;
+    out.energy = stretch_energy(d, s.l0, k_, law_, g ? &gd : nullptr, h ? &Hd : nullptr);
+    if (want.gradient) out.gradient.head<4>() << -gd, gd;
+    if (want.strain) {  // d(d)/dt = c: dE/dt = g.c, d2E/dt2 = c.H c, d2E/dx dt = +-H c
+        out.dE_dt = gd.dot(c);
+        out.d2E_dt2 = c.dot(Hd * c);
+        const Eigen::Vector2d hc = Hd * c;
+        out.d2E_dqdt.head<4>() << -hc, hc;
+    }
+    if (want.hessian) {
+        const Eigen::Matrix2d hp = want.psd ? project_psd(Hd) : Hd;
+        Eigen::Matrix4d hl;
+        hl << hp, -hp, -hp, hp;
+        out.hessian.topLeftCorner<4, 4>() = hl;
+    }
+}
+
 }  // namespace fibernet

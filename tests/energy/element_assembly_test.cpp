@@ -120,3 +120,30 @@ TEST_CASE("element assembly: the dry energy is bit for bit the committed referen
     }
     set_thread_count(0);
 }
+
+TEST_CASE("element assembly: parallel assembly is bit for bit the serial one", "[energy][assembly]") {
+    // Large enough (> 4096 elements) for the threads to split the elements and the gathers; the reference above is
+    // assembled by one thread.
+    MikadoParams p;
+    p.L = 12, p.q = 5, p.pl = 0.6, p.seed = 4;
+    DiscretizationParams d;
+    d.scheme = Scheme::Seed, d.n_seg = 4, d.h = 3.0, d.aspect_ratio = 10;
+    const Model m = discretize(generate_mikado(p), d);
+    REQUIRE(m.segments.size() + m.hinges.size() > 4096);
+    const NetworkEnergy e(m);
+    Eigen::Matrix2d F, dF;
+    F << 1, 0.1, 0, 1, dF << 0, 1, 0, 0;
+    const Eigen::VectorXd q = reference_state(e, F);
+    for (unsigned want : {unsigned(kGradient | kHessian | kStrain), unsigned(kGradient | kStrain | kComoving), 0u}) {
+        set_thread_count(1);
+        const Fingerprint serial = evaluate(e, q, F, dF, want);
+        for (int threads : {2, 3, 5}) {
+            set_thread_count(threads);
+            const Fingerprint f = evaluate(e, q, F, dF, want);
+            INFO("want " << want << ", threads " << threads);
+            CHECK(f.hash == serial.hash);
+            CHECK(f.energy == serial.energy);
+        }
+    }
+    set_thread_count(0);
+}

@@ -10,8 +10,12 @@
 // The Hessian's upper-triangular pattern is built once per model; evaluate() refills the values.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <memory>
+#include <string>
 #include <vector>
 
+#include "fibernet/energy/bend.hpp"
+#include "fibernet/energy/element_assembly.hpp"
 #include "fibernet/energy/objective.hpp"
 #include "fibernet/energy/stretch.hpp"
 #include "fibernet/model/model.hpp"
@@ -40,7 +44,8 @@ enum Want : unsigned {
 };
 
 struct EnergyEval {
-    double energy = 0, stretch = 0, bend = 0;
+    double energy = 0, stretch = 0, bend = 0;  // the total and the two dry terms' shares (terms, by name)
+    std::vector<double> terms;       // the energy by term, in NetworkEnergy::term_names() order
     Eigen::VectorXd gradient;        // over free coordinates
     double dE_dt = 0;                // strain derivatives along dF
     Eigen::VectorXd d2E_dqdt;
@@ -71,7 +76,9 @@ public:
     void evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F, const Eigen::Matrix2d& dF, unsigned want,
                   EnergyEval& out, Eigen::SparseMatrix<double>* H = nullptr) const;
 
-    const Eigen::SparseMatrix<double>& hessian_pattern() const { return pattern_; }
+    const Eigen::SparseMatrix<double>& hessian_pattern() const { return assembly_->pattern(); }
+    // The element terms (element_term.hpp) in assembly order: stretch, bend.
+    std::vector<std::string> term_names() const;
 
     // One element at a time, for a caller that assembles part of the network (wet/wet_region.hpp). u: every node's
     // displacement from displacements(q, F) (fixed nodes at (F - I) x_ref). Local coordinates are the element's
@@ -88,12 +95,11 @@ private:
     const Model& model_;
     EnergyParams params_;
     int ndof_ = 0;
-    std::vector<int> dof_;                 // 2 per node: index into q or -1
-    Eigen::SparseMatrix<double> pattern_;  // upper triangle
-    std::vector<int> seg_slots_;           // 10 per segment: value index of local upper entry (a<=b) or -1
-    std::vector<int> hinge_slots_;         // 21 per hinge
-    std::vector<Eigen::Vector2d> seg_d0_;  // rest vectors per segment
-    std::vector<Eigen::Vector2d> hinge_d0_;  // 2 per hinge
+    std::vector<int> dof_;  // 2 per node: index into q or -1
+    // On the heap, so that the assembly's pointers to the terms stay valid when the energy is moved.
+    std::unique_ptr<StretchTerm> stretch_;
+    std::unique_ptr<BendTerm> bend_;
+    std::unique_ptr<ElementAssembly> assembly_;
 };
 
 // The energy at a fixed deformation F, as a solver sees it.

@@ -10,6 +10,9 @@
 // the segment collapses (eps -> -1). With k_sc = u*^3 the softcore adds k_sc h''(u) = 2 (u*/u)^3 - 2 to f''=2: the
 // curvature doubles at u = u*/2^(1/3) and grows like u^-3 below.
 #include <Eigen/Core>
+#include <vector>
+
+#include "fibernet/energy/element_term.hpp"
 
 namespace fibernet {
 
@@ -24,5 +27,22 @@ struct StretchLaw {
 // with respect to d. k = 4 a^2.
 double stretch_energy(const Eigen::Vector2d& d, double l0, double k, const StretchLaw& law, Eigen::Vector2d* grad,
                       Eigen::Matrix2d* hess);
+
+// The stretching term over a model's segments (element: the segment's nodes i, j).
+class StretchTerm : public ElementTerm {
+public:
+    StretchTerm(const Model& m, StretchLaw law);  // keeps a reference to m
+    const char* name() const override { return "stretch"; }
+    int valence() const override { return 2; }
+    std::size_t size() const override { return m_.segments.size(); }
+    void nodes(std::size_t e, int* out) const override;
+    void evaluate(std::size_t e, const ElementFrame& frame, const ElementWant& want, ElementResult& out) const override;
+
+private:
+    const Model& m_;
+    StretchLaw law_;
+    double k_;                             // 4 a^2
+    std::vector<Eigen::Vector2d> d0_;      // rest vectors
+};
 
 }  // namespace fibernet
