@@ -17,13 +17,13 @@ constexpr std::size_t kParallelElements = 4096;
 
 // Counting sort of (target, source) pairs into compressed lists that keep the sources' given order per target.
 void compress(std::size_t targets, const std::vector<std::pair<std::size_t, std::size_t>>& pairs,
-              std::vector<std::size_t>& ptr, std::vector<std::size_t>& src) {
+              std::vector<std::size_t>& ptr, std::vector<std::uint32_t>& src) {
     ptr.assign(targets + 1, 0);
     for (const auto& p : pairs) ++ptr[p.first + 1];
     for (std::size_t t = 0; t < targets; ++t) ptr[t + 1] += ptr[t];
     src.resize(pairs.size());
     std::vector<std::size_t> fill(ptr.begin(), ptr.end() - 1);
-    for (const auto& p : pairs) src[fill[p.first]++] = p.second;
+    for (const auto& p : pairs) src[fill[p.first]++] = static_cast<std::uint32_t>(p.second);
 }
 
 // The upper pattern: node adjacency over elements (each node with itself), then coordinate level column by column.
@@ -84,6 +84,7 @@ ElementAssembly::ElementAssembly(std::vector<const ElementTerm*> terms, const st
         coord_offset_.push_back(coord_offset_.back() + t->size() * 2 * t->valence());
         upper_offset_.push_back(upper_offset_.back() + t->size() * upper_count(2 * t->valence()));
     }
+    if (upper_offset_.back() > UINT32_MAX) throw std::length_error("element assembly: more than 2^32 Hessian entries");
     pattern_ = element_pattern(terms_, dof, ndof);
     std::vector<std::pair<std::size_t, std::size_t>> grad, hess;
     int nodes[kMaxElementCoords / 2];
@@ -99,12 +100,13 @@ ElementAssembly::ElementAssembly(std::vector<const ElementTerm*> terms, const st
             std::size_t s = 0;
             for (int a = 0; a < M; ++a) {
                 const int r = dof[2 * nodes[a / 2] + a % 2];
+                coord_index_.push_back(r);
                 if (r >= 0) grad.push_back({static_cast<std::size_t>(r), g0 + a});
                 for (int b = a; b < M; ++b, ++s) {
                     const int c = dof[2 * nodes[b / 2] + b % 2];
-                    if (r < 0 || c < 0) continue;
-                    hess.push_back({static_cast<std::size_t>(pattern_slot(pattern_, std::min(r, c), std::max(r, c))),
-                                    h0 + s});
+                    const int slot = r < 0 || c < 0 ? -1 : pattern_slot(pattern_, std::min(r, c), std::max(r, c));
+                    upper_slot_.push_back(slot);
+                    if (slot >= 0) hess.push_back({static_cast<std::size_t>(slot), h0 + s});
                 }
             }
         }
@@ -113,16 +115,62 @@ ElementAssembly::ElementAssembly(std::vector<const ElementTerm*> terms, const st
     compress(pattern_.nonZeros(), hess, hess_ptr_, hess_src_);
 }
 
+// One thread: each element's results added where they go as it is evaluated (the loop the dry energy had), which
+// makes every sum in the same order as the gathers below.
+void ElementAssembly::scatter_serially(const ElementFrame& frame, const ElementWant& want, Sums& sums,
+                                       Eigen::VectorXd* gradient, Eigen::VectorXd* d2E_dqdt,
+                                       double* hessian_values) const {
+    const bool wg = want.gradient && gradient, wh = want.hessian && hessian_values, ws = want.strain;
+    const bool wt = ws && d2E_dqdt;
+    if (wg) gradient->setZero(ndof_);
+    if (wt) d2E_dqdt->setZero(ndof_);
+    if (wh) std::fill(hessian_values, hessian_values + pattern_.nonZeros(), 0.0);
+    ElementWant w = want;
+    w.gradient = wg, w.hessian = wh;
+    sums.energy.assign(terms_.size(), 0.0);
+    sums.dE_dt = sums.d2E_dt2 = sums.d2E_dt2_size = 0;
+    ElementResult r;
+    for (std::size_t k = 0; k < terms_.size(); ++k) {
+        const ElementTerm* t = terms_[k];
+        const int M = 2 * t->valence(), U = upper_count(M);
+        const int* idx = &coord_index_[coord_offset_[k]];
+        const int* slot = &upper_slot_[upper_offset_[k]];
+        for (std::size_t e = 0; e < t->size(); ++e, idx += M, slot += U) {
+            t->evaluate(e, frame, w, r);
+            sums.energy[k] += r.energy;
+            if (ws) {
+                sums.dE_dt += r.dE_dt;
+                sums.d2E_dt2 += r.d2E_dt2;
+                sums.d2E_dt2_size += std::abs(r.d2E_dt2);
+            }
+            for (int a = 0; a < M; ++a) {
+                if (idx[a] < 0) continue;
+                if (wg) (*gradient)[idx[a]] += r.gradient[a];
+                if (wt) (*d2E_dqdt)[idx[a]] += r.d2E_dqdt[a];
+            }
+            if (!wh) continue;
+            int s = 0;
+            for (int a = 0; a < M; ++a)
+                for (int b = a; b < M; ++b, ++s)
+                    if (slot[s] >= 0) hessian_values[slot[s]] += r.hessian(a, b);
+        }
+    }
+}
+
 void ElementAssembly::assemble(const ElementFrame& frame, const ElementWant& want, Sums& sums,
                                Eigen::VectorXd* gradient, Eigen::VectorXd* d2E_dqdt, double* hessian_values) const {
+    const std::size_t n = first_.back();
+    const int threads = n >= kParallelElements ? thread_count() : 1;
+    if (threads <= 1) {
+        scatter_serially(frame, want, sums, gradient, d2E_dqdt, hessian_values);
+        return;
+    }
     const bool wg = want.gradient && gradient, wh = want.hessian && hessian_values, ws = want.strain;
     Buffers& buf = buffers();
-    const std::size_t n = first_.back();
     buf.energy.resize(n);
     if (wg) buf.gradient.resize(coord_offset_.back());
     if (wh) buf.upper.resize(upper_offset_.back());
     if (ws) buf.dE_dt.resize(n), buf.d2E_dt2.resize(n), buf.d2E_dqdt.resize(coord_offset_.back());
-    const int threads = n >= kParallelElements ? thread_count() : 1;
     ElementWant w = want;
     w.gradient = wg, w.hessian = wh;
     parallel_ranges(n, threads, [&](std::size_t lo, std::size_t hi) {
@@ -152,12 +200,12 @@ void ElementAssembly::assemble(const ElementFrame& frame, const ElementWant& wan
                       nh = wh ? static_cast<std::size_t>(pattern_.nonZeros()) : 0;
     if (wg) gradient->resize(ndof_);
     if (nt) d2E_dqdt->resize(ndof_);
-    parallel_ranges(ng + nt + nh, ng + nt + nh >= kParallelElements ? threads : 1, [&](std::size_t lo, std::size_t hi) {
+    parallel_ranges(ng + nt + nh, threads, [&](std::size_t lo, std::size_t hi) {
         for (std::size_t i = lo; i < hi; ++i) {
             const bool g = i < ng, t = !g && i < ng + nt;
             const std::size_t r = g ? i : t ? i - ng : i - ng - nt;
             const std::vector<std::size_t>& ptr = g || t ? grad_ptr_ : hess_ptr_;
-            const std::vector<std::size_t>& src = g || t ? grad_src_ : hess_src_;
+            const std::vector<std::uint32_t>& src = g || t ? grad_src_ : hess_src_;
             const std::vector<double>& from = g ? buf.gradient : t ? buf.d2E_dqdt : buf.upper;
             double s = 0.0;
             for (std::size_t j = ptr[r]; j < ptr[r + 1]; ++j) s += from[src[j]];

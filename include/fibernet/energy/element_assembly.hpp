@@ -8,6 +8,7 @@
 // after element (the dry energy's before issue 22; tests/energy/element_assembly_test.cpp).
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <cstdint>
 #include <vector>
 
 #include "fibernet/energy/element_term.hpp"
@@ -43,7 +44,14 @@ private:
     Eigen::SparseMatrix<double> pattern_;
     // Contributions in summation order: to free coordinate r, coordinate buffer entries grad_src_[grad_ptr_[r] ..
     // grad_ptr_[r + 1]); to Hessian value s, packed entries hess_src_[hess_ptr_[s] .. hess_ptr_[s + 1]).
-    std::vector<std::size_t> grad_ptr_, grad_src_, hess_ptr_, hess_src_;
+    std::vector<std::size_t> grad_ptr_, hess_ptr_;
+    std::vector<std::uint32_t> grad_src_, hess_src_;  // 4 bytes: the gathers are bound by memory traffic
+    // Per element, for one thread's scatter (the same sums in the same order): each local coordinate's index in q
+    // and each packed Hessian entry's value slot (-1: fixed).
+    std::vector<int> coord_index_, upper_slot_;
+
+    void scatter_serially(const ElementFrame& frame, const ElementWant& want, Sums& sums, Eigen::VectorXd* gradient,
+                          Eigen::VectorXd* d2E_dqdt, double* hessian_values) const;
 };
 
 }  // namespace fibernet
