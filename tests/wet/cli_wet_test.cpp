@@ -89,6 +89,17 @@ TEST_CASE("cli wet: a small run writes its documented outputs", "[wet][cli]") {
     CHECK(j.find("\"complete\": true") != std::string::npos);  // false in the copies written between betas
     CHECK(slurp(out + "/sweep.csv").rfind("beta,status,bridges", 0) == 0);
     CHECK(slurp(out + "/sweep.csv").find("G_dry,G_wet,G_dry_fd,G_wet_fd") != std::string::npos);
+    // The pores block classifies every face (pores.hpp): on the torus the classes tile the box, pores.csv has the
+    // pores only, and the wall width is the default contact distance 2/a.
+    const nlohmann::json s = read_json(out + "/summary.json");
+    REQUIRE(s.is_object());
+    const nlohmann::json& p = s["runs"][0]["pores"]["wet"];
+    CHECK(p["cover"].get<double>() == Approx(1).epsilon(1e-12));
+    CHECK(p["wall_width"].get<double>() == Approx(0.2));
+    double pores = 0;
+    for (const char* k : {"wall_area", "island_area", "open_area"}) pores += p[k].get<double>();
+    CHECK(p["remainder_area"].get<double>() == Approx(pores).margin(1e-9 * p["box_area"].get<double>()));
+    CHECK(lines(out + "/pores.csv") == 1 + 2 * p["count"].get<int>());  // header, dry and wet rows (beta = 0)
     // Progress on stderr by default: a line per beta and per active-set round; none with --quiet.
     const std::string err = slurp(tmpdir() + "/stderr");
     CHECK(err.find("wet: beta = 0 (1 of 1)") != std::string::npos);
