@@ -87,28 +87,31 @@ void NetworkEnergy::displacement_of(int i, const Eigen::VectorXd& q, const Eigen
     else u.segment<2>(2 * i) = (F - Eigen::Matrix2d::Identity()) * model_.x.segment<2>(2 * i);
 }
 
-double NetworkEnergy::segment_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F, Eigen::Vector4d* g,
-                                   Eigen::Matrix4d* H, bool psd) const {
-    const ElementFrame frame(model_, dof_, u, F, Eigen::Matrix2d::Zero(), false, false);
+namespace {
+// One element of term t at displacements u (no strain), its gradient and Hessian on the M local coordinates.
+template <int M>
+double one_element(const ElementTerm& t, int e, const ElementFrame& frame, Eigen::Matrix<double, M, 1>* g,
+                   Eigen::Matrix<double, M, M>* H, bool psd) {
     ElementWant want;
     want.gradient = g, want.hessian = H, want.psd = psd;
     ElementResult r;
-    stretch_->evaluate(e, frame, want, r);
-    if (g) *g = r.gradient.head<4>();
-    if (H) *H = r.hessian.topLeftCorner<4, 4>();
+    t.evaluate(e, frame, want, r);
+    if (g) *g = r.gradient.head<M>();
+    if (H) *H = r.hessian.topLeftCorner<M, M>();
     return r.energy;
+}
+}  // namespace
+
+double NetworkEnergy::segment_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F, Eigen::Vector4d* g,
+                                   Eigen::Matrix4d* H, bool psd) const {
+    return one_element<4>(*stretch_, e, ElementFrame(model_, dof_, u, F, Eigen::Matrix2d::Zero(), false, false), g, H,
+                          psd);
 }
 
 double NetworkEnergy::hinge_term(int e, const Eigen::VectorXd& u, const Eigen::Matrix2d& F,
                                  Eigen::Matrix<double, 6, 1>* g, Eigen::Matrix<double, 6, 6>* H, bool psd) const {
-    const ElementFrame frame(model_, dof_, u, F, Eigen::Matrix2d::Zero(), false, false);
-    ElementWant want;
-    want.gradient = g, want.hessian = H, want.psd = psd;
-    ElementResult r;
-    bend_->evaluate(e, frame, want, r);
-    if (g) *g = r.gradient.head<6>();
-    if (H) *H = r.hessian.topLeftCorner<6, 6>();
-    return r.energy;
+    return one_element<6>(*bend_, e, ElementFrame(model_, dof_, u, F, Eigen::Matrix2d::Zero(), false, false), g, H,
+                          psd);
 }
 
 void NetworkEnergy::evaluate(const Eigen::VectorXd& q, const Eigen::Matrix2d& F, const Eigen::Matrix2d& dF,
