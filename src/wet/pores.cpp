@@ -10,7 +10,6 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
-#include <unordered_map>
 
 namespace fibernet {
 

@@ -22,15 +22,6 @@ SmoothWetParams smooth(double beta, const CapillaryLaw& law = {}) {
     return p;
 }
 
-CapillaryLaw table() {
-    std::vector<double> a, v;
-    for (int i = 0; i <= 18; ++i) {
-        const double r = 5.0 * i * M_PI / 180;
-        a.push_back(5.0 * i), v.push_back(-std::cos(r) * std::cos(r) + 0.1 * std::sin(2 * r) * std::sin(2 * r));
-    }
-    return CapillaryLaw::tabulated(a, v, "test table");
-}
-
 // The whole energy and its capillary part (the dry part is much stiffer and would hide an error in it), and the strain
 // derivatives along simple shear and a general direction. min_pairs: non-zero pairs the layout must have.
 void check_derivatives(const Model& m, const Eigen::Matrix2d& F, double amp, std::uint64_t seed,
@@ -98,7 +89,7 @@ std::vector<Line> moved_by(std::vector<Line> lines, double dx, double dy) {
 
 TEST_CASE("smooth wet energy: gradient, Hessian and strain derivatives match finite differences",
           "[wet][smooth][gradient][hessian]") {
-    const CapillaryLaw def, tab = table();
+    const CapillaryLaw def, tab = tabulated_law();
     Eigen::Matrix2d sheared;
     sheared << 1, 0.3, 0, 1.1;
     SECTION("crossing near a node of one fiber, and of both") {

@@ -108,18 +108,10 @@ std::vector<Line> moved_by(std::vector<Line> lines, double dx, double dy) {
     return lines;
 }
 
-CapillaryLaw table() {
-    std::vector<double> a, v;
-    for (int i = 0; i <= 18; ++i) {
-        const double r = 5.0 * i * M_PI / 180;
-        a.push_back(5.0 * i), v.push_back(-std::cos(r) * std::cos(r) + 0.1 * std::sin(2 * r) * std::sin(2 * r));
-    }
-    return CapillaryLaw::tabulated(a, v, "test table");
-}
 }  // namespace
 
 TEST_CASE("wet energy: gradient and Hessian match finite differences", "[wet][gradient][hessian]") {
-    const CapillaryLaw def, tab = table();
+    const CapillaryLaw def, tab = tabulated_law();
     // Fiber 1 along x with nodes every 0.1; fiber 2 crosses it 0.01 (blend zone: |z| < 0.025) past a node.
     Eigen::Matrix2d sheared;
     sheared << 1, 0.3, 0, 1.1;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "../energy/fd.hpp"
+#include "fibernet/energy/capillary.hpp"
 #include "fibernet/energy/network_energy.hpp"
 #include "fibernet/model/discretize.hpp"
 #include "fibernet/network/mikado.hpp"
@@ -116,6 +117,17 @@ inline Network mikado(double L, double q, double pl, std::uint64_t seed) {
     MikadoParams p;
     p.L = L, p.q = q, p.pl = pl, p.seed = seed;
     return generate_mikado(p);
+}
+
+// A tabulated capillary law unlike the default -cos^2 (a bump at 45 deg), for the finite-difference checks of both
+// wet models' tabulated regime.
+inline CapillaryLaw tabulated_law() {
+    std::vector<double> a, v;
+    for (int i = 0; i <= 18; ++i) {
+        const double r = 5.0 * i * M_PI / 180;
+        a.push_back(5.0 * i), v.push_back(-std::cos(r) * std::cos(r) + 0.1 * std::sin(2 * r) * std::sin(2 * r));
+    }
+    return CapillaryLaw::tabulated(a, v, "test table");
 }
 
 // A small random network (seed scheme, 4 segments per fiber) with every fifth node fixed (a clamp), for the
