@@ -293,12 +293,14 @@ void register_wet(CLI::App& app) {
         opt.active_set.bundle_partners = s.wet.bundle_partners;
         opt.model = parse_wet_model(s.wet.model);
         opt.smooth.skin = s.wet.skin;
+        opt.smooth.bundle_partners = s.wet.bundle_partners;
         opt.smooth.pair.crossing_width = s.wet.crossing_width;  // 0: from the model (run_wet)
         opt.smooth.pair.contact = s.wet.contact_distance;
         opt.smooth.pair.overlap_width = 0;  // the fiber radius
         opt.smooth_relax.round_iterations = s.wet.round_iterations;
         opt.smooth_relax.max_rounds = s.wet.max_rounds;
         opt.smooth_relax.ldl = s.wet.newton_ldl;
+        opt.smooth_relax.projected = s.wet.newton_projected;
         opt.smooth_relax.progress = w->verbose || !w->quiet;
         if (w->verbose && w->quiet) throw InputError("--verbose and --quiet contradict each other");
         opt.moduli = !w->no_moduli;
@@ -360,6 +362,7 @@ void register_wet(CLI::App& app) {
             {"max_rounds", s.wet.max_rounds},
             {"round_iterations", s.wet.round_iterations},
             {"newton_ldl", s.wet.newton_ldl},
+            {"newton_projected", s.wet.newton_projected},
             {"local_fraction", s.wet.local_fraction},
             {"local_threshold", s.wet.local_threshold},
             {"local_hops", s.wet.local_hops},
@@ -559,7 +562,13 @@ void register_wet(CLI::App& app) {
                                                                           {"pattern_builds", r.smooth.pattern_builds},
                                                                           {"stale_patterns", r.smooth.stale_patterns},
                                                                           {"factorizations", r.smooth.factorizations},
-                                                                          {"seconds_patterns", r.smooth.seconds_patterns}}},
+                                                                          {"seconds_patterns", r.smooth.seconds_patterns},
+                                                                          {"seconds_solver",
+                                                                           {{"assembly", r.smooth.timings.assembly},
+                                                                            {"factorization",
+                                                                             r.smooth.timings.factorization},
+                                                                            {"line_search", r.smooth.timings.line_search},
+                                                                            {"total", r.smooth.timings.total}}}}},
                  {"seconds",
                   {{"dry", r.seconds_dry}, {"wet_solve", r.seconds_wet_solve}, {"events", r.seconds_events},
                    {"pores", r.seconds_pores}, {"moduli", r.seconds_moduli},

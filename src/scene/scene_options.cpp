@@ -127,6 +127,10 @@ std::vector<SceneOption> declare() {
     add(integer("wet", "round_iterations", "", "Newton iterations per round while the set changes",
                 [](Scene& s) -> int& { return s.wet.round_iterations; }));
     add(boolean("wet", "newton_ldl", "", "Newton's first rung by LDL^T", [](Scene& s) -> bool& { return s.wet.newton_ldl; }));
+    add(boolean("wet", "newton_projected", "--projected",
+                "smooth model: projected Newton (element-wise PSD Hessian until full steps, then exact) instead of "
+                "newton_ldl (docs/wet.md)",
+                [](Scene& s) -> bool& { return s.wet.newton_projected; }));
     add(real("wet", "local_fraction", "", "local rounds: largest part of the coordinates",
              [](Scene& s) -> double& { return s.wet.local_fraction; }));
     add(real("wet", "local_threshold", "", "local rounds: hot where |g| > threshold x max|g|",

@@ -88,6 +88,7 @@ public:
         H_ = f.hessian_pattern();
         g_.resize(n), gt_.resize(n), d_.resize(n), qt_.resize(n);
         if (opt_.eliminate && n > 0) ne_ = std::make_unique<NonlinearElimination>(H_, opt_.elimination);
+        if (opt_.projected) start_rung_ = 1;
         return assemble(run, q, 0);
     }
 
@@ -222,8 +223,18 @@ private:
                          shift, accepted ? alpha : 0.0);
         if (!accepted) return false;
         update_shift(level, shift, alpha, ft, mu, dm, retried);
-        start_rung_ = std::max(0, std::min(level, 2) - 1);
+        start_rung_ = next_start(level, alpha);
         return true;
+    }
+
+    // Where the next iteration's ladder starts: one level above this step's. Projected Newton (SolverOptions::projected)
+    // stays on the projected Hessian (assembled alone, without the exact one first) until a step was accepted in full,
+    // then tries the exact Hessian, which a full step suggests is near positive definite: element-wise projection
+    // overstates the stiffness, and near a minimum only the exact Hessian converges quadratically.
+    int next_start(int level, double alpha) const {
+        if (!opt_.projected) return std::max(0, std::min(level, 2) - 1);
+        if (alpha == 1 && level <= 1) return 0;
+        return std::max(1, std::min(level, 2) - 1);
     }
 
     // Armijo backtracking from alpha = 1 along d (then, unless d came from the steepest rung or from a modified
@@ -293,7 +304,7 @@ private:
 
 SolverCapabilities NewtonSolver::capabilities() const {
     SolverCapabilities c;
-    c.hessian = c.ldl = c.eliminate = c.warm_start = c.newton_steps = c.shares_factorization = true;
+    c.hessian = c.ldl = c.projected = c.eliminate = c.warm_start = c.newton_steps = c.shares_factorization = true;
     return c;
 }
 
@@ -314,7 +325,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         ldl_->analyze(f.hessian_pattern());
         run.result().timings.factorization += since(t0);
     }
-    NewtonLadder ladder(llt, opt_.ldl ? ldl_.get() : nullptr);
+    NewtonLadder ladder(llt, opt_.ldl ? ldl_.get() : nullptr, !opt_.projected);
     Newton method(opt_, ladder, ladder.modified_ldl(), trace_.shift_rel, trace_);
     return run_iterations(run, method, q);
 }

@@ -65,6 +65,7 @@ bool ShiftedHessianRung::direction(LadderState& s, Eigen::VectorXd& d, double& s
         shift = s.mu;
         return true;
     }
+    if (!escalate_) return false;
     for (double lam = std::max(kExactGrow * s.mu, kLambda0 * s.dm); lam <= kExactCap * s.dm; lam *= kExactGrow)
         if (s.factor_and_solve(lin_, lam, d)) {
             shift = lam;
@@ -98,13 +99,13 @@ bool SteepestDescentRung::direction(LadderState& s, Eigen::VectorXd& d, double& 
     return true;
 }
 
-NewtonLadder::NewtonLadder(LinearSolver& llt, LinearSolver* ldl) {
+NewtonLadder::NewtonLadder(LinearSolver& llt, LinearSolver* ldl, bool escalate) {
     if (ldl) {
         auto r = std::make_unique<ModifiedLdlRung>(*ldl);
         ldl_ = r.get();
         rungs_.push_back(std::move(r));
     }
-    rungs_.push_back(std::make_unique<ShiftedHessianRung>(llt));
+    rungs_.push_back(std::make_unique<ShiftedHessianRung>(llt, escalate));
     rungs_.push_back(std::make_unique<ProjectedHessianRung>(llt));
     rungs_.push_back(std::make_unique<ProjectedShiftRung>(llt));
     rungs_.push_back(std::make_unique<SteepestDescentRung>());

@@ -12,7 +12,9 @@ namespace fibernet {
 
 namespace {
 
-using J = Jet<8>;
+// The pair's energy is invariant under translation: it is differentiated in the 6 coordinates of p1, q0, q1 relative to
+// p0 (Y below), whose jets carry 36 Hessian entries instead of 64, and mapped back by X -> Y's constant Jacobian T.
+using J = Jet<6>;
 
 // f(x) from f, f', f'' at x's value: the double itself, or the chain rule on a jet.
 inline double lift(double, double f, double, double) { return f; }
@@ -192,40 +194,76 @@ void CapillaryPairParams::check(const char* where) const {
                          std::to_string(angle_hi_deg) + " deg must satisfy 0 < lo < hi < 90");
 }
 
+
+namespace {
+
+// Y = (0, 0, p1 - p0, q0 - p0, q1 - p0): the pair with p0 at the origin (the terms see the same geometry).
+Vector8d relative(const Vector8d& X) {
+    Vector8d Y;
+    for (int i = 0; i < 8; ++i) Y[i] = X[i] - X[i % 2];
+    return Y;
+}
+
+// The gradient and Hessian in X from those in Y's 6 free coordinates: g_X = T^T g_Y, H_X = T^T H_Y T.
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+Vector8d to_pair(const Vector6d& gy) {
+    Vector8d g;
+    g.segment<6>(2) = gy;
+    g[0] = -(gy[0] + gy[2] + gy[4]), g[1] = -(gy[1] + gy[3] + gy[5]);
+    return g;
+}
+Matrix8d to_pair(const Matrix6d& Hy) {
+    Eigen::Matrix<double, 8, 6> A;  // T^T H_Y
+    A.bottomRows<6>() = Hy;
+    A.row(0) = -(Hy.row(0) + Hy.row(2) + Hy.row(4)), A.row(1) = -(Hy.row(1) + Hy.row(3) + Hy.row(5));
+    Matrix8d H;
+    H.rightCols<6>() = A;
+    H.col(0) = -(A.col(0) + A.col(2) + A.col(4)), H.col(1) = -(A.col(1) + A.col(3) + A.col(5));
+    return 0.5 * (H + H.transpose());  // exactly symmetric (the two sums of the node-0 block differ in round-off)
+}
+
+}  // namespace
+
 bool capillary_pair_vanishes(const Vector8d& X, bool wet_crossing, const CapillaryPairParams& p) {
-    const Active a = active_terms(X.data(), wet_crossing, consts(p), nullptr);
+    const Active a = active_terms(relative(X).data(), wet_crossing, consts(p), nullptr);
     return !a.crossing && !a.contact;
 }
 
 double capillary_pair_energy(const Vector8d& X, double l0a, double l0b, bool wet_crossing,
                              const CapillaryPairParams& p, Vector8d* grad, Matrix8d* hess, bool project_psd,
-                             CapillaryPairParts* parts) {
+                             CapillaryPairParts* parts, double contact_scale, Vector8d* contact_grad) {
     const Consts k = consts(p);
-    const Active a = active_terms(X.data(), wet_crossing, k, parts);
+    const Vector8d Y = relative(X);
+    const Active a = active_terms(Y.data(), wet_crossing, k, parts);
     const double lbar = 0.5 * (l0a + l0b);
     if (grad) grad->setZero();
     if (hess) hess->setZero();
+    if (contact_grad) contact_grad->setZero();
     if (!a.crossing && !a.contact) return 0;
-    if (!grad && !hess) {
+    if (!grad && !hess && !contact_grad) {
         double Ex, Ec;
-        terms(X.data(), lbar, p, k, a, Ex, Ec);
+        terms(Y.data(), lbar, p, k, a, Ex, Ec);
         if (parts) parts->crossing_energy = Ex, parts->contact_energy = Ec;
-        return Ex + Ec;
+        return contact_scale == 1 ? Ex + Ec : Ex + contact_scale * Ec;
     }
-    J Xj[8];
-    for (int i = 0; i < 8; ++i) Xj[i] = J::variable(X[i], i);
+    J Yj[8];
+    Yj[0] = J(0.0), Yj[1] = J(0.0);
+    for (int i = 0; i < 6; ++i) Yj[2 + i] = J::variable(Y[2 + i], i);
     J Ex, Ec;
-    terms(Xj, lbar, p, k, a, Ex, Ec);
+    terms(Yj, lbar, p, k, a, Ex, Ec);
     if (parts) parts->crossing_energy = Ex.v, parts->contact_energy = Ec.v;
-    const J E = Ex + Ec;
-    if (grad) *grad = E.g;
+    if (contact_grad) *contact_grad = to_pair(Ec.g);
+    const J E = contact_scale == 1 ? Ex + Ec : Ex + contact_scale * Ec;
+    if (grad) *grad = to_pair(E.g);
     if (hess) {
-        *hess = 0.5 * (E.h + E.h.transpose());
+        Matrix6d Hy = 0.5 * (E.h + E.h.transpose());
         if (project_psd) {
-            Eigen::SelfAdjointEigenSolver<Matrix8d> es(*hess);
-            const Vector8d ev = es.eigenvalues().cwiseMax(0.0);
-            *hess = es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
+            Eigen::SelfAdjointEigenSolver<Matrix6d> es(Hy);
+            const Vector6d ev = es.eigenvalues().cwiseMax(0.0);
+            Hy = es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
         }
+        *hess = to_pair(Hy);
     }
     return E.v;
 }

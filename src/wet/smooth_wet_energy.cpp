@@ -7,6 +7,7 @@
 
 #include "fibernet/energy/sparse_pattern.hpp"
 #include "fibernet/util/parallel.hpp"
+#include "fibernet/wet/bundle_saturation.hpp"
 
 namespace fibernet {
 
@@ -150,10 +151,13 @@ void SmoothWetEnergy::build_pattern(const Eigen::VectorXd& x, const Eigen::Matri
         local_dofs(P[k], e);
         idx.insert(idx.end(), e, e + 8);
     }
+    std::vector<int> partner_idx;
+    if (capped()) add_partner_blocks(take, x, B, partner_idx);
     const Eigen::SparseMatrix<double>& D = dry_.hessian_pattern();
     PatternBuilder builder(dry_.num_dofs());
     builder.add_pattern(D);
     builder.add_elements(idx, 8);
+    builder.add_elements(partner_idx, 8);
     pattern_ = builder.build();
     dry_slot_ = subpattern_slots(pattern_, D);
     element_slots(pattern_, idx, 8, slots_);
@@ -174,6 +178,11 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
     ensure_list(x, B);
     const std::vector<SegmentPair>& P = list_.pairs();
     const std::vector<int> on = nonzero_pairs(x, B);
+    // With the partner cap, the energy and each pair's contact weight come from a first pass over the pairs' values.
+    PartnerCap pc;
+    if (capped()) pc = partner_cap(x, B, on);
+    const bool pairs_pass = g || H || !capped();
+    const bool saturation_hessian = H && !pc.saturating.empty();
     // The non-zero pairs in chunks, each evaluated in parallel into its own slots and added in list order after the
     // dry terms (evaluated beside the first chunk).
     const size_t n = on.size(), chunk = H ? std::min(n, kChunk) : n;
@@ -185,6 +194,7 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
     cE.resize(chunk);
     if (g || H) cg.resize(chunk);
     if (H) cH.resize(chunk);
+    if (saturation_hessian) contact_grad_.resize(n);
     double E = 0;
     double* hv = nullptr;
     auto dry_terms = [&] {
@@ -195,8 +205,8 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
             hv = assign_subpattern(dry_H_, dry_slot_, *H);
         }
     };
-    if (n == 0) dry_terms();
-    for (size_t c0 = 0; c0 < n; c0 += chunk) {
+    if (n == 0 || !pairs_pass) dry_terms();
+    for (size_t c0 = 0; c0 < n && pairs_pass; c0 += chunk) {
         const size_t c1 = std::min(n, c0 + chunk);
         parallel_blocks(c1 - c0, threads, 64, [&] { if (c0 == 0) dry_terms(); }, [&](size_t lo, size_t hi) {
             for (size_t i = lo; i < hi; ++i) {
@@ -204,12 +214,14 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
                 const Model& m = dry_.model();
                 cE[i] = capillary_pair_energy(list_.coordinates(p, x, B), m.segments[p.a].l0, m.segments[p.b].l0,
                                               wet_[on[c0 + i]], params_.pair, g || H ? &cg[i] : nullptr,
-                                              H ? &cH[i] : nullptr, psd);
+                                              H ? &cH[i] : nullptr, psd, nullptr,
+                                              capped() ? pc.scale[c0 + i] : 1.0,
+                                              saturation_hessian ? &contact_grad_[c0 + i] : nullptr);
             }
         });
         for (size_t i = 0; i < c1 - c0; ++i) {
             const int k = on[c0 + i];
-            E += cE[i];
+            if (!capped()) E += cE[i];
             if (!g && !H) continue;
             int idx[8];
             local_dofs(P[k], idx);
@@ -219,7 +231,135 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
                             H ? cH[i].data() : nullptr, g, H && pk >= 0 ? hv : nullptr);
         }
     }
+    if (capped()) E += pc.crossing + pc.contact;
+    if (saturation_hessian) add_saturation_hessian(pc, on, contact_grad_, hv);
     return E;
+}
+
+SmoothWetEnergy::PartnerCap SmoothWetEnergy::partner_cap(const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+                                                         const std::vector<int>& on) const {
+    const std::vector<SegmentPair>& P = list_.pairs();
+    const Model& m = dry_.model();
+    const size_t n = on.size();
+    std::vector<double> Ex(n), Ec(n);
+    parallel_ranges(n, n >= 64 ? thread_count() : 1, [&](size_t lo, size_t hi) {
+        for (size_t i = lo; i < hi; ++i) {
+            const SegmentPair& p = P[on[i]];
+            CapillaryPairParts parts;
+            capillary_pair_energy(list_.coordinates(p, x, B), m.segments[p.a].l0, m.segments[p.b].l0, wet_[on[i]],
+                                  params_.pair, nullptr, nullptr, false, &parts);
+            Ex[i] = parts.crossing_energy, Ec[i] = parts.contact_energy;
+        }
+    });
+    // C_a, summed in list order (the same for any thread count).
+    PartnerCap pc;
+    std::vector<double> C(m.segments.size(), 0.0), dS(m.segments.size(), 1.0);
+    for (size_t i = 0; i < n; ++i) {
+        const SegmentPair& p = P[on[i]];
+        pc.crossing += Ex[i];
+        C[p.a] += Ec[i], C[p.b] += Ec[i];
+    }
+    const double beta = params_.pair.beta;
+    pc.n.assign(C.size(), 0.0);
+    for (size_t a = 0; a < C.size(); ++a) {
+        if (C[a] == 0) continue;
+        const double l = m.segments[a].l0;
+        pc.n[a] = -C[a] / (beta * l);
+        const Saturation s = bundle_saturation(pc.n[a], params_.bundle_partners);
+        pc.contact += -0.5 * beta * l * s.S;
+        dS[a] = s.dS;
+        if (s.d2S != 0) pc.saturating.push_back(static_cast<int>(a)), pc.kappa.push_back(-s.d2S / (2 * beta * l));
+    }
+    pc.scale.resize(n), pc.touching.resize(n);
+    for (size_t i = 0; i < n; ++i) pc.scale[i] = 0.5 * (dS[P[on[i]].a] + dS[P[on[i]].b]), pc.touching[i] = Ec[i] != 0;
+    return pc;
+}
+
+std::vector<std::vector<int>> SmoothWetEnergy::saturating_pairs(const PartnerCap& pc, const std::vector<int>& on) const {
+    std::vector<int> which(dry_.model().segments.size(), -1);
+    for (size_t j = 0; j < pc.saturating.size(); ++j) which[pc.saturating[j]] = static_cast<int>(j);
+    std::vector<std::vector<int>> out(pc.saturating.size());
+    const std::vector<SegmentPair>& P = list_.pairs();
+    for (size_t i = 0; i < on.size(); ++i) {
+        const SegmentPair& p = P[on[i]];
+        if (!pc.touching[i]) continue;
+        if (which[p.a] >= 0) out[which[p.a]].push_back(static_cast<int>(i));
+        if (which[p.b] >= 0) out[which[p.b]].push_back(static_cast<int>(i));
+    }
+    return out;
+}
+
+void SmoothWetEnergy::add_saturation_hessian(const PartnerCap& pc, const std::vector<int>& on,
+                                             const std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>>& cgrad,
+                                             double* hv) {
+    const std::vector<SegmentPair>& P = list_.pairs();
+    const std::vector<std::vector<int>> pairs = saturating_pairs(pc, on);
+    const int* outer = pattern_.outerIndexPtr();
+    const int* inner = pattern_.innerIndexPtr();
+    std::vector<std::pair<int, double>> G;
+    for (size_t j = 0; j < pairs.size(); ++j) {
+        // G_a = grad C_a, merged by coordinate.
+        G.clear();
+        for (int i : pairs[j]) {
+            int idx[8];
+            local_dofs(P[on[i]], idx);
+            for (int l = 0; l < 8; ++l)
+                if (idx[l] >= 0) G.emplace_back(idx[l], cgrad[i][l]);
+        }
+        std::sort(G.begin(), G.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
+        size_t w = 0;
+        for (size_t r = 0; r < G.size(); ++r) {
+            if (w > 0 && G[w - 1].first == G[r].first) G[w - 1].second += G[r].second;
+            else G[w++] = G[r];
+        }
+        G.resize(w);
+        for (size_t v = 0; v < G.size(); ++v) {
+            const int col = G[v].first;
+            const int* lo = inner + outer[col];
+            const int* hi = inner + outer[col + 1];
+            for (size_t u = 0; u <= v; ++u) {
+                const int* it = std::lower_bound(lo, hi, G[u].first);
+                if (it == hi || *it != G[u].first) {
+                    stale_ = true;
+                    continue;
+                }
+                hv[it - inner] += pc.kappa[j] * G[u].second * G[v].second;
+            }
+        }
+    }
+}
+
+void SmoothWetEnergy::add_partner_blocks(const std::vector<char>& take, const Eigen::VectorXd& x,
+                                         const Eigen::Matrix2d& B, std::vector<int>& idx) const {
+    // Aligned: within 15 deg beyond the contact term's reach at the build; near the blend: n_a within 1/2 of it (the
+    // coupling is kappa_a G_a G_a^T, non-zero only inside the blend). So the blocks cover the motion until the next
+    // rebuild; a segment that saturates outside them marks the pattern stale.
+    const double reach = std::sin((params_.pair.angle_hi_deg + 15) * M_PI / 180);
+    const double N = params_.bundle_partners, h = kSaturationHalfWidth + 0.5;
+    const std::vector<double> n = partner_cap(x, B, nonzero_pairs(x, B)).n;
+    const std::vector<SegmentPair>& P = list_.pairs();
+    std::vector<std::vector<int>> partners(dry_.model().segments.size());
+    for (size_t k = 0; k < P.size(); ++k) {
+        if (!take[k]) continue;
+        const Vector8d X = list_.coordinates(P[k], x, B);
+        const Eigen::Vector2d d1 = X.segment<2>(2) - X.segment<2>(0), d2 = X.segment<2>(6) - X.segment<2>(4);
+        const double cr = d1.x() * d2.y() - d1.y() * d2.x();
+        if (cr * cr > reach * reach * d1.squaredNorm() * d2.squaredNorm()) continue;
+        for (const int a : {P[k].a, P[k].b})
+            if (std::abs(n[a] - N) < h) partners[a].push_back(static_cast<int>(k));
+    }
+    for (size_t a = 0; a < partners.size(); ++a) {
+        const std::vector<int>& L = partners[a];
+        for (size_t u = 0; u < L.size(); ++u)
+            for (size_t v = u + 1; v < L.size(); ++v) {
+                int eu[8], ev[8];
+                local_dofs(P[L[u]], eu), local_dofs(P[L[v]], ev);
+                const int* ou = P[L[u]].a == static_cast<int>(a) ? eu + 4 : eu;  // the partner's half
+                const int* ov = P[L[v]].a == static_cast<int>(a) ? ev + 4 : ev;
+                idx.insert(idx.end(), ou, ou + 4);
+                idx.insert(idx.end(), ov, ov + 4);
+            }
+    }
 }
 
 double SmoothWetEnergy::value(const Eigen::VectorXd& q) { return eval(q, nullptr, nullptr, false); }
@@ -242,16 +382,46 @@ void SmoothWetEnergy::for_each_nonzero(const Eigen::VectorXd& q,
 void SmoothWetEnergy::strain_derivatives(const Eigen::VectorXd& q, const Eigen::Matrix2d& dF, EnergyEval& out,
                                          bool comoving) const {
     dry_.evaluate(q, F_, dF, kStrain | (comoving ? kComoving : 0u), out);
+    if (!active()) return;
     const Model& m = dry_.model();
+    const Eigen::VectorXd x = dry_.positions(q, F_);
+    const Eigen::Matrix2d B = F_ * m.box.B0();
+    ensure_list(x, B);
+    const std::vector<SegmentPair>& P = list_.pairs();
+    const std::vector<int> on = nonzero_pairs(x, B);
+    PartnerCap pc;
+    if (capped()) pc = partner_cap(x, B, on);
+    const bool saturation = !pc.saturating.empty();
+    // With saturating segments, also each pair's contact gradient and rate dC_ab/dt (the cap's kappa_a (dC_a/dt)^2
+    // and kappa_a dC_a/dt grad C_a, bundle_saturation.hpp).
+    std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>> cg(saturation ? on.size() : 0);
+    std::vector<double> rate(saturation ? on.size() : 0);
     Vector8d g;
     Matrix8d He;
-    for_each_nonzero(q, [&](const SegmentPair& p, const Vector8d& X) {
-        capillary_pair_energy(X, m.segments[p.a].l0, m.segments[p.b].l0, wet_crossing(p), params_.pair, &g, &He);
+    for (size_t i = 0; i < on.size(); ++i) {
+        const SegmentPair& p = P[on[i]];
+        const Vector8d X = list_.coordinates(p, x, B);
+        capillary_pair_energy(X, m.segments[p.a].l0, m.segments[p.b].l0, wet_[on[i]], params_.pair, &g, &He, false,
+                              nullptr, capped() ? pc.scale[i] : 1.0, saturation ? &cg[i] : nullptr);
         int node[4];
         Eigen::Vector2i shift[4];
         list_.nodes(p, node, shift);
         add_strain_terms<4>(dry_, F_, dF, comoving, node, shift, X, g, He, out);
-    });
+        if (saturation) rate[i] = cg[i].dot(strain_rate<4>(dry_, F_, dF, comoving, node, shift, X));
+    }
+    const std::vector<std::vector<int>> pairs = saturation ? saturating_pairs(pc, on) : std::vector<std::vector<int>>{};
+    for (size_t j = 0; j < pairs.size(); ++j) {
+        double Cdot = 0;
+        for (int i : pairs[j]) Cdot += rate[i];
+        const double tt = pc.kappa[j] * Cdot * Cdot;
+        out.d2E_dt2 += tt, out.d2E_dt2_size += std::abs(tt);
+        for (int i : pairs[j]) {
+            int idx[8];
+            local_dofs(P[on[i]], idx);
+            for (int l = 0; l < 8; ++l)
+                if (idx[l] >= 0) out.d2E_dqdt[idx[l]] += pc.kappa[j] * Cdot * cg[i][l];
+        }
+    }
 }
 
 void SmoothWetEnergy::for_each_part(const Eigen::VectorXd& q,
@@ -270,6 +440,14 @@ SmoothWetSplit SmoothWetEnergy::split(const Eigen::VectorXd& q) const {
     dry_.evaluate(q, F_, Eigen::Matrix2d::Zero(), kValue, ev);
     SmoothWetSplit s;
     s.stretch = ev.stretch, s.bend = ev.bend;
+    if (capped() && active()) {
+        const Eigen::VectorXd x = dry_.positions(q, F_);
+        const Eigen::Matrix2d B = F_ * dry_.model().box.B0();
+        ensure_list(x, B);
+        const PartnerCap pc = partner_cap(x, B, nonzero_pairs(x, B));
+        s.crossing = pc.crossing, s.contact = pc.contact;
+        return s;
+    }
     for_each_part(q, [&](const SegmentPair&, const CapillaryPairParts& parts) {
         s.crossing += parts.crossing_energy, s.contact += parts.contact_energy;
     });

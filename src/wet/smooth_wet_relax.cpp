@@ -32,7 +32,10 @@ SmoothRelaxResult relax_smooth_wet(SmoothWetEnergy& W, Solver& solver, Eigen::Ve
         o.max_iter = cap;
         o.warm_start = base.warm_start || (R.rounds > 1 && caps.warm_start);
         if (base.max_step == 0 && W.params().pair.beta > 0) o.max_step = opt.max_step < 0 ? W.params().skin : opt.max_step;
-        o.ldl = base.ldl || (opt.ldl && caps.ldl && W.params().pair.beta > 0);  // beta = 0: the dry solve, bit for bit
+        // beta = 0: the dry solve, bit for bit
+        const bool wet = W.params().pair.beta > 0;
+        o.projected = base.projected || (opt.projected && caps.projected && wet);
+        o.ldl = !o.projected && (base.ldl || (opt.ldl && caps.ldl && wet));
         R.last = solver.minimize(W, q);
         R.iterations += R.last.iterations, R.factorizations += R.last.factorizations;
         R.evaluations += R.last.evaluations;

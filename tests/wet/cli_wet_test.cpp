@@ -385,6 +385,31 @@ TEST_CASE("cli wet: the smooth model relaxes to an equilibrium of the whole ener
     CHECK(std::abs(G - Gfd) <= 1e-3 * G);
 }
 
+TEST_CASE("cli wet: the smooth model with projected Newton and a partner cap", "[wet][cli][smooth]") {
+    // A cap of 1 binds at beta = 0.1 on this network (the capillary energy is above the uncapped one), and the exact
+    // linear modulus, whose strain derivatives carry the cap's coupling, matches the second difference.
+    const std::string out = tmpdir() + "/smooth_cap";
+    const std::string net = "--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.1 --wet-model smooth --tol 1e-9 -q -o " + out;
+    REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
+    REQUIRE(run(net) == 0);
+    const double uncapped = read_json(out + "/summary.json")["runs"][0]["energy"]["wet"]["capillary"].get<double>();
+    REQUIRE(run("--projected --bundle-partners 1 " + net) == 0);
+    const nlohmann::json j = read_json(out + "/summary.json");
+    CHECK(j["wet"]["newton_projected"] == true);
+    CHECK(j["wet"]["bundle_partners"] == 1);
+    const nlohmann::json& r = j["runs"][0];
+    CHECK(r["status"] == "stable");
+    CHECK(r["smooth"]["grad_max"].get<double>() <= 1e-9);
+    CHECK(r["energy"]["wet"]["capillary"].get<double>() < 0);
+    CHECK(r["energy"]["wet"]["capillary"].get<double>() > uncapped + 0.1);
+    const double G = r["shear_modulus"]["wet"].get<double>(), Gfd = r["shear_modulus_second_difference"]["wet"].get<double>();
+    CHECK(G > 0);
+    CHECK(std::abs(G - Gfd) <= 1e-3 * G);
+    // Projected Newton belongs to the smooth model.
+    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.1 --projected -q -o " + out + "_events") == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("[wet].newton_projected") != std::string::npos);
+}
+
 TEST_CASE("cli wet: the smooth model's options are refused by name", "[wet][cli][smooth][input]") {
     const std::string out = tmpdir() + "/smooth_bad";
     REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
@@ -396,7 +421,7 @@ TEST_CASE("cli wet: the smooth model's options are refused by name", "[wet][cli]
     CHECK(slurp(tmpdir() + "/stderr").find("[wet].crossing_width") != std::string::npos);
     CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --free-box -q -o " + out) == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("free_box") != std::string::npos);
-    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --bundle-partners 2 -q -o " + out) == 2);
-    CHECK(slurp(tmpdir() + "/stderr").find("[wet].bundle_partners = 2") != std::string::npos);
+    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --bundle-partners -2 -q -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("[wet].bundle_partners = -2") != std::string::npos);
     CHECK(!exists(out));
 }

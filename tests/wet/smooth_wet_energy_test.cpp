@@ -16,21 +16,25 @@ using namespace wetfix;
 
 namespace {
 
-SmoothWetParams smooth(double beta, const CapillaryLaw& law = {}) {
+SmoothWetParams smooth(double beta, const CapillaryLaw& law = {}, int partners = 0) {
     SmoothWetParams p;
-    p.pair.beta = beta, p.pair.law = law;
+    p.pair.beta = beta, p.pair.law = law, p.bundle_partners = partners;
     return p;
 }
 
 // The whole energy and its capillary part (the dry part is much stiffer and would hide an error in it), and the strain
 // derivatives along simple shear and a general direction. min_pairs: non-zero pairs the layout must have.
 void check_derivatives(const Model& m, const Eigen::Matrix2d& F, double amp, std::uint64_t seed,
-                       const CapillaryLaw& law, size_t min_pairs, bool strained = false) {
+                       const CapillaryLaw& law, size_t min_pairs, bool strained = false, int partners = 0) {
     NetworkEnergy dry(m);
     Eigen::VectorXd q = perturb(dry.affine_map(dry.dofs(m.x), Eigen::Matrix2d::Identity(), F), amp, seed);
-    const SmoothWetParams p = smooth(2.5, law), p0 = smooth(0);
+    const SmoothWetParams p = smooth(2.5, law, partners), p0 = smooth(0);
     SmoothWetEnergy W(dry, F, p, {}, q), D(dry, F, p0, {}, q);
     REQUIRE(W.bridges(q).size() >= min_pairs);
+    if (partners > 0) {  // the cap must act here: some segment saturates
+        SmoothWetEnergy U(dry, F, smooth(2.5, law), {}, q);
+        REQUIRE(std::abs(W.value(q) - U.value(q)) > 1e-3);
+    }
     const auto hessians = check_against_differences(W, D, q);
     const Eigen::MatrixXd& Hcap = hessians.second;
     CHECK(!W.pattern_stale());
@@ -72,8 +76,11 @@ void check_derivatives(const Model& m, const Eigen::Matrix2d& F, double amp, std
         EnergyEval cw, cd;
         W.strain_derivatives(q, dF, cw, true);
         D.strain_derivatives(q, dF, cd, true);
-        const double Ecm = (w.d2E_dt2 - d.d2E_dt2) + 2 * v.dot(w.d2E_dqdt - d.d2E_dqdt) + v.dot(Hcap * v);
-        CHECK(std::abs((cw.d2E_dt2 - cd.d2E_dt2) - Ecm) <= 1e-9 * (1 + std::abs(Ecm)));
+        const double a1 = w.d2E_dt2 - d.d2E_dt2, a2 = 2 * v.dot(w.d2E_dqdt - d.d2E_dqdt), a3 = v.dot(Hcap * v);
+        const double Ecm = a1 + a2 + a3;
+        // Two paths to one number: equal to round-off of the summands, which can cancel by orders of magnitude.
+        CHECK(std::abs((cw.d2E_dt2 - cd.d2E_dt2) - Ecm) <=
+              1e-9 * (1 + std::abs(a1) + std::abs(a2) + std::abs(a3)));
         CHECK(fdtest::rel_err(cw.d2E_dqdt - cd.d2E_dqdt, Eigen::VectorXd(w.d2E_dqdt - d.d2E_dqdt + Hcap * v), 1e-6) <
               1e-8);
         if (strained) CHECK(std::abs(w.d2E_dt2 - d.d2E_dt2) > 1e-4);
@@ -115,6 +122,15 @@ TEST_CASE("smooth wet energy: gradient, Hessian and strain derivatives match fin
             check_derivatives(model_of(network_of(moved_by(lines, -1.0, -1.5), 3)), sheared, 0.004, 32, tab, 3, true);
         }
     }
+    SECTION("stacks of aligned fibers under the partner cap (segments in the saturation blend)") {
+        // Three fibers at 0, 3 and -2 deg within 0.01 of each other: the middle overlaps hold n ~ 2 partners, in the
+        // blend of a cap of 2; two fibers under a cap of 1 (n ~ 1, in its blend).
+        const std::vector<Line> three = {{1.0, 1.5, 0, 1, 0.5}, {1.1, 1.505, 3, 1, 0.5}, {1.2, 1.51, -2, 1, 0.5}};
+        const std::vector<Line> two = {{1.0, 1.5, 0, 1, 0.5}, {1.2, 1.505, 4, 1, 0.5}};
+        check_derivatives(model_of(network_of(three, 3)), Eigen::Matrix2d::Identity(), 0.004, 51, def, 6, false, 2);
+        check_derivatives(model_of(network_of(moved_by(three, -1.0, -1.5), 3)), sheared, 0.004, 52, tab, 6, true, 2);
+        check_derivatives(model_of(network_of(two, 3)), Eigen::Matrix2d::Identity(), 0.004, 53, def, 3, false, 1);
+    }
     SECTION("a random Mikado network, seed scheme, fixed nodes in a sheared box") {
         check_derivatives(model_of(mikado(2.5, 4, 0.5, 7), 4), Eigen::Matrix2d::Identity(), 0.002, 41, def, 5);
         check_derivatives(clamped_network(), clamped_box(), 0.002, 42, def, 5);
@@ -140,20 +156,23 @@ TEST_CASE("smooth wet energy: bit for bit the same on any number of threads", "[
     const Model m = model_of(mikado(8, 10, 0.5, 4), 10);
     NetworkEnergy dry(m);
     const Eigen::VectorXd q = perturb(dry.dofs(m.x), 0.01, 9);
-    SmoothWetEnergy W(dry, Eigen::Matrix2d::Identity(), smooth(0.3), {}, q);
-    REQUIRE(W.bridges(q).size() > 1000);
-    auto evaluate = [&](int threads, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H) {
-        set_thread_count(threads);
-        H = W.hessian_pattern();
-        return W.hessian(q, g, H, false);
-    };
-    Eigen::VectorXd g1, g3;
-    Eigen::SparseMatrix<double> H1, H3;
-    const double e1 = evaluate(1, g1, H1), e3 = evaluate(3, g3, H3);
-    set_thread_count(0);
-    CHECK(e1 == e3);
-    CHECK((g1.array() == g3.array()).all());
-    CHECK(std::equal(H1.valuePtr(), H1.valuePtr() + H1.nonZeros(), H3.valuePtr()));
+    for (const int partners : {0, 1}) {  // without and with the partner cap (a cap of 1 saturates many segments)
+        SmoothWetEnergy W(dry, Eigen::Matrix2d::Identity(), smooth(0.3, {}, partners), {}, q);
+        REQUIRE(W.bridges(q).size() > 1000);
+        auto evaluate = [&](int threads, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H) {
+            set_thread_count(threads);
+            H = W.hessian_pattern();
+            return W.hessian(q, g, H, false);
+        };
+        Eigen::VectorXd g1, g3;
+        Eigen::SparseMatrix<double> H1, H3;
+        const double e1 = evaluate(1, g1, H1), e3 = evaluate(3, g3, H3);
+        set_thread_count(0);
+        INFO("partners " << partners);
+        CHECK(e1 == e3);
+        CHECK((g1.array() == g3.array()).all());
+        CHECK(std::equal(H1.valuePtr(), H1.valuePtr() + H1.nonZeros(), H3.valuePtr()));
+    }
 }
 
 TEST_CASE("smooth wet energy: no energy change as a straight fiber slides along itself, in a bundle or across a crossing",
@@ -222,4 +241,34 @@ TEST_CASE("smooth wet energy: a two-fiber bundle adheres with -beta per unit ove
         CHECK(s.crossing == 0);
         CHECK(s.contact == Approx(-beta * 8).epsilon(0.05));
     }
+}
+
+TEST_CASE("smooth wet energy: the partner cap bounds a stack's adhesion and leaves a two-fiber bundle alone",
+          "[wet][smooth][physics]") {
+    // Four parallel fibers, 0.005 apart (all within the contact distance of each other), overlapping along their
+    // whole length of 10 seed units: 6 adhering pairs without a cap (-60 beta); each segment has n = 3 partners, so a
+    // cap of 2 gives -(beta / 2) 4 x 10 x S(3) = -40 beta, a cap of 6 (n below it) the pair sum.
+    const double beta = 0.3;
+    std::vector<Line> stack;
+    for (int k = 0; k < 4; ++k) stack.push_back({1.5, 1.5 + 0.005 * k, 0, 1, 0.5});
+    const Model m = model_of(network_of(stack, 3), 10);
+    NetworkEnergy dry(m);
+    const Eigen::VectorXd q = dry.dofs(m.x);
+    auto contact = [&](int partners) {
+        return SmoothWetEnergy(dry, Eigen::Matrix2d::Identity(), smooth(beta, {}, partners), {}, q).split(q).contact;
+    };
+    const double none = contact(0);
+    CHECK(none == Approx(-60 * beta).epsilon(0.02));
+    CHECK(contact(2) == Approx(-40 * beta).epsilon(0.02));
+    CHECK(contact(6) == Approx(none).epsilon(1e-12));
+    CHECK(SmoothWetEnergy(dry, Eigen::Matrix2d::Identity(), smooth(beta, {}, 2), {}, q).value(q) ==
+          Approx(contact(2)).epsilon(1e-12));  // the value is the split's (no dry energy at rest)
+    // Two of them: n = 1, below a cap of 2.
+    const Model m2 = model_of(network_of({stack[0], stack[1]}, 3), 10);
+    NetworkEnergy dry2(m2);
+    const Eigen::VectorXd q2 = dry2.dofs(m2.x);
+    const double two = SmoothWetEnergy(dry2, Eigen::Matrix2d::Identity(), smooth(beta), {}, q2).value(q2);
+    CHECK(two == Approx(-10 * beta).epsilon(0.02));
+    CHECK(SmoothWetEnergy(dry2, Eigen::Matrix2d::Identity(), smooth(beta, {}, 2), {}, q2).value(q2) ==
+          Approx(two).epsilon(1e-12));
 }

@@ -34,6 +34,7 @@ struct WetSettings {
     int max_rounds = 1000;      // active-set rounds (bridge-set updates) per relaxation, >= 1
     int round_iterations = 10;  // Newton iterations per round while the set changes (0: solve each round to the end)
     bool newton_ldl = true;     // Newton's first rung by LDL^T with flipped negative pivots (docs/wet.md)
+    bool newton_projected = false;  // smooth model: projected Newton (SolverOptions::projected) instead of newton_ldl
     // Local rounds (docs/wet.md, "Local rounds"): the part of the network that needs a solve, if it holds at most
     // local_fraction of the coordinates (0: every round global); hot: |g| > local_threshold x max|g|, grown by local_hops.
     double local_fraction = 0.25;

@@ -4,6 +4,7 @@
 // ladder tries its rungs in order from the iteration's starting level and takes the first direction found.
 //   level 0  ModifiedLdlRung       (SolverOptions::ldl) H + mu I by a factorization that replaces negative pivots
 //            ShiftedHessianRung    exact H + mu I, then the shift raised 4x at a time up to 0.2 mean diag(H)
+//                                  (SolverOptions::projected: exact H + mu I only, not escalated)
 //   level 1  ProjectedHessianRung  element-wise PSD-projected H + mu I
 //   level 2  ProjectedShiftRung    projected H + lambda I, lambda = 1e-8 mean diag(H) 10^j, j = 0..10
 //   level 3  SteepestDescentRung   d = -g / mean diag(H)
@@ -77,10 +78,14 @@ private:
 
 class ShiftedHessianRung : public FactoringRung {
 public:
-    using FactoringRung::FactoringRung;
-    std::string name() const override { return "shifted exact " + lin_.name(); }
+    // escalate = false: H + mu I only (projected Newton tries the exact Hessian as it is, then projects).
+    ShiftedHessianRung(LinearSolver& lin, bool escalate = true) : FactoringRung(lin), escalate_(escalate) {}
+    std::string name() const override { return (escalate_ ? "shifted exact " : "exact ") + lin_.name(); }
     int level() const override { return 0; }
     bool direction(LadderState& s, Eigen::VectorXd& d, double& shift) override;
+
+private:
+    bool escalate_;
 };
 
 class ProjectedHessianRung : public FactoringRung {
@@ -107,10 +112,11 @@ public:
 };
 
 // The rungs in order. `ldl`: the modified factorization for level 0 (SolverOptions::ldl), or null; `llt`: the
-// definite factorization of the other rungs.
+// definite factorization of the other rungs; escalate: whether level 0's exact shift is raised before the ladder
+// moves on to the projected Hessian (false for SolverOptions::projected).
 class NewtonLadder {
 public:
-    NewtonLadder(LinearSolver& llt, LinearSolver* ldl);
+    NewtonLadder(LinearSolver& llt, LinearSolver* ldl, bool escalate = true);
     // The first rung at or above `start_level` with a direction; the steepest-descent rung always has one.
     NewtonRung& descend(LadderState& s, int start_level, Eigen::VectorXd& d, double& shift);
     NewtonRung& steepest() { return *rungs_.back(); }

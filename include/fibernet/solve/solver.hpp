@@ -22,6 +22,9 @@ struct SolverOptions {
                              // that resumes an interrupted solve of a slightly changed objective; others ignore it
     bool ldl = false;        // Newton: rung 0 by a simplicial LDL^T of the exact H + mu I with negative pivots flipped
                              // (cholmod_ldl.hpp) instead of the escalated shift; others ignore it
+    bool projected = false;  // Newton: projected Newton (newton_ladder.hpp): the element-wise PSD-projected H + mu I
+                             // by LL^T while far from a minimum, the exact H + mu I (not shifted further) once a full
+                             // step was accepted; excludes ldl. Others ignore it
     bool eliminate = false;  // Newton: nonlinear elimination of the hot places before and inside each global step
                              // (nonlinear_elimination.hpp); others ignore it
     EliminationOptions elimination;
@@ -38,6 +41,7 @@ struct SolverOptions {
 struct SolverCapabilities {
     bool hessian = false;       // assembles the sparse Hessian
     bool ldl = false;           // SolverOptions::ldl acts
+    bool projected = false;     // SolverOptions::projected acts
     bool eliminate = false;     // SolverOptions::eliminate acts
     bool warm_start = false;    // SolverOptions::warm_start acts
     bool newton_steps = false;  // an iteration is a factorized Newton step, so a few of them make a round of the wet

@@ -66,9 +66,12 @@ struct CapillaryPairParts {
 
 // X = (p0, p1, q0, q1). Value and, where non-null, gradient and Hessian in X. wet_crossing: the crossing term applies
 // (false: contact term only). project_psd: the Hessian projected to positive semidefinite (eigen-decomposition).
+// contact_scale: the contact term enters scaled by it (the partner cap's weight of the pair, bundle_saturation.hpp;
+// 1: the pair term itself, bit for bit); contact_grad: the unscaled contact term's gradient.
 double capillary_pair_energy(const Vector8d& X, double l0a, double l0b, bool wet_crossing,
                              const CapillaryPairParams& p, Vector8d* grad, Matrix8d* hess, bool project_psd = false,
-                             CapillaryPairParts* parts = nullptr);
+                             CapillaryPairParts* parts = nullptr, double contact_scale = 1,
+                             Vector8d* contact_grad = nullptr);
 
 // Whether the pair's energy is exactly zero with zero derivatives at X (cheap: no derivatives), so that an assembler
 // can skip it.

@@ -13,6 +13,11 @@
 // sets pattern_stale(); the driver (relax_smooth_wet) then calls rebuild(). The pattern is fixed between rebuild()
 // calls, as a solver expects (objective.hpp).
 //
+// Partner cap (SmoothWetParams::bundle_partners = N > 0, bundle_saturation.hpp): the contact parts of the pairs are
+// summed per segment and saturated there, so a pair's contact term enters with the weight (S'_a + S'_b) / 2 and a
+// segment inside the saturation blend couples all its partners (a rank-one term, whose blocks the pattern adds for
+// segments near the blend); the energy is then a pass over the pairs' values ahead of their derivatives.
+//
 // With beta = 0 no pair is evaluated and the pattern is the dry one: values, gradients and Hessians are the dry ones
 // bit for bit. Sums run in pair order after the dry terms, the same for any thread count.
 #include <Eigen/Core>
@@ -34,6 +39,7 @@ struct SmoothWetParams {
     CapillaryPairParams pair;
     double skin = 0.5;              // neighbour-list skin (seed units)
     double pattern_distance = 0;    // 0: 1.5 contact + overlap_width + crossing_width
+    int bundle_partners = 0;        // the partner cap N (bundle_saturation.hpp); 0: none
 };
 
 struct SmoothWetSplit {
@@ -89,6 +95,26 @@ private:
     // f(pair, its local coordinates) for every non-zero pair at q, in list order.
     void for_each_nonzero(const Eigen::VectorXd& q,
                           const std::function<void(const SegmentPair&, const Vector8d&)>& f) const;
+    // The partner cap (bundle_saturation.hpp) at positions x over the non-zero pairs `on`.
+    struct PartnerCap {
+        std::vector<double> scale;    // per entry of `on`: the pair's contact weight (S'(n_a) + S'(n_b)) / 2
+        std::vector<char> touching;   // per entry of `on`: its contact term is non-zero
+        std::vector<int> saturating;  // segments with S''(n_a) != 0, ascending
+        std::vector<double> kappa;    // per saturating segment: d2E / dC_a^2 = -S''(n_a) / (2 beta l_a) >= 0
+        std::vector<double> n;        // per segment: n_a
+        double crossing = 0, contact = 0;  // the crossing terms' energy and the capped contact energy
+    };
+    bool capped() const { return params_.bundle_partners > 0; }
+    PartnerCap partner_cap(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on) const;
+    // Per saturating segment: the entries of `on` whose pair holds it and has a contact term.
+    std::vector<std::vector<int>> saturating_pairs(const PartnerCap& pc, const std::vector<int>& on) const;
+    // Adds the cap's coupling of each saturating segment's partners, kappa_a G_a G_a^T with G_a the gradient of its
+    // contact energy C_a (from the pairs' contact gradients cgrad, in `on` order), to the values hv of the pattern.
+    void add_saturation_hessian(const PartnerCap& pc, const std::vector<int>& on,
+                                const std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>>& cgrad, double* hv);
+    // The cap's extra pattern: per segment, the blocks between the segments of its aligned patterned partners.
+    void add_partner_blocks(const std::vector<char>& take, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+                            std::vector<int>& idx) const;
     // f(pair, its parts) for every non-zero pair at q, in list order.
     void for_each_part(const Eigen::VectorXd& q,
                        const std::function<void(const SegmentPair&, const CapillaryPairParts&)>& f) const;
@@ -120,6 +146,7 @@ private:
     std::vector<double> chunk_E_;
     std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>> chunk_g_;
     std::vector<Matrix8d, Eigen::aligned_allocator<Matrix8d>> chunk_H_;
+    std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>> contact_grad_;  // per non-zero pair (partner cap)
     std::vector<int> seg_fiber_, seg_index_;  // per segment: fiber and index in its chain
 };
 

@@ -21,6 +21,7 @@ struct SmoothRelaxOptions {
     bool progress = false;  // a line per round on stderr
     double max_step = -1;   // Newton: largest coordinate change per step (SolverOptions::max_step); < 0: the skin
     bool ldl = true;        // Newton's first rung by LDL^T with flipped negative pivots (SolverOptions::ldl), beta > 0
+    bool projected = false; // projected Newton (SolverOptions::projected), beta > 0; takes precedence over ldl
     bool always_rebuild = false;  // rebuild the list after every round, needed or not (tests: the same equilibrium)
 };
 

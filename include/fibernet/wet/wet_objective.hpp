@@ -27,14 +27,14 @@ public:
 // node), so dX_a/dt = w_a = dF r_a with r_a = B0 shift_a (+ x_ref for a fixed node), and its terms are g.w, H w and
 // w.H w. comoving: along the affine path of every node, w_a = dF F^-1 (X_a - X_first) (each element is translation
 // invariant, so only its own extent enters).
+// The rate dX/dt = w of an element's local coordinates along the strain path (add_strain_terms below).
 template <int M>
-void add_strain_terms(const NetworkEnergy& dry, const Eigen::Matrix2d& F, const Eigen::Matrix2d& dF, bool comoving,
-                      const int* node, const Eigen::Vector2i* shift, const Eigen::Matrix<double, 2 * M, 1>& X,
-                      const Eigen::Matrix<double, 2 * M, 1>& g, const Eigen::Matrix<double, 2 * M, 2 * M>& H,
-                      EnergyEval& out) {
+Eigen::Matrix<double, 2 * M, 1> strain_rate(const NetworkEnergy& dry, const Eigen::Matrix2d& F, const Eigen::Matrix2d& dF,
+                                            bool comoving, const int* node, const Eigen::Vector2i* shift,
+                                            const Eigen::Matrix<double, 2 * M, 1>& X) {
     const Model& m = dry.model();
     const Eigen::Matrix2d B0 = m.box.B0(), V = dF * F.inverse();
-    Eigen::Matrix<double, 2 * M, 1> w = Eigen::Matrix<double, 2 * M, 1>::Zero(), Hw;
+    Eigen::Matrix<double, 2 * M, 1> w = Eigen::Matrix<double, 2 * M, 1>::Zero();
     int first = -1;
     for (int a = 0; a < M; ++a) {
         if (node[a] < 0) continue;
@@ -47,6 +47,16 @@ void add_strain_terms(const NetworkEnergy& dry, const Eigen::Matrix2d& F, const 
         if (dry.dof(node[a], 0) < 0) r += m.x.segment<2>(2 * node[a]);  // a fixed node sits at F x_ref
         w.template segment<2>(2 * a) = dF * r;
     }
+    return w;
+}
+
+template <int M>
+void add_strain_terms(const NetworkEnergy& dry, const Eigen::Matrix2d& F, const Eigen::Matrix2d& dF, bool comoving,
+                      const int* node, const Eigen::Vector2i* shift, const Eigen::Matrix<double, 2 * M, 1>& X,
+                      const Eigen::Matrix<double, 2 * M, 1>& g, const Eigen::Matrix<double, 2 * M, 2 * M>& H,
+                      EnergyEval& out) {
+    const Eigen::Matrix<double, 2 * M, 1> w = strain_rate<M>(dry, F, dF, comoving, node, shift, X);
+    Eigen::Matrix<double, 2 * M, 1> Hw;
     Hw.noalias() = H * w;
     out.dE_dt += g.dot(w);
     const double tt = w.dot(Hw);
