@@ -7,6 +7,7 @@
 // reported, marked). With -o, the directory's previous results are invalidated at the start, and the tables and
 // summary.json (complete: false) are rewritten after every beta; SIGINT/SIGTERM end the run at once with the finished
 // betas kept and reported (exit 130).
+#include <algorithm>
 #include <unistd.h>
 
 #include <atomic>
@@ -303,6 +304,14 @@ void register_wet(CLI::App& app) {
         opt.smooth_relax.projected = s.wet.newton_projected;
         opt.smooth_relax.progress = w->verbose || !w->quiet;
         if (w->verbose && w->quiet) throw InputError("--verbose and --quiet contradict each other");
+        // The smooth model's pair sum lets fibers stack without bound; at strong wetting its answer then depends on the
+        // solver's path (docs/wet.md, "The partner cap in the smooth model"). Said once, quiet or not.
+        if (opt.model == WetModel::Smooth && s.wet.bundle_partners == 0 &&
+            *std::max_element(betas.begin(), betas.end()) >= 0.1)
+            std::fprintf(stderr,
+                         "wet: note: the smooth model without a partner cap at beta >= 0.1: fibers can stack without "
+                         "bound and the equilibrium found depends on the solver's path; --bundle-partners 2 caps it "
+                         "(docs/wet.md, \"The partner cap in the smooth model\")\n");
         opt.moduli = !w->no_moduli;
         if (o_ms->count()) {
             check_value(std::isfinite(w->modulus_strain) && w->modulus_strain > 0 && w->modulus_strain <= 0.1,

@@ -392,8 +392,10 @@ TEST_CASE("cli wet: the smooth model with projected Newton and a partner cap", "
     const std::string net = "--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.1 --wet-model smooth --tol 1e-9 -q -o " + out;
     REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
     REQUIRE(run(net) == 0);
+    CHECK(slurp(tmpdir() + "/stderr").find("without a partner cap") != std::string::npos);  // said even with -q
     const double uncapped = read_json(out + "/summary.json")["runs"][0]["energy"]["wet"]["capillary"].get<double>();
     REQUIRE(run("--projected --bundle-partners 1 " + net) == 0);
+    CHECK(slurp(tmpdir() + "/stderr").find("without a partner cap") == std::string::npos);
     const nlohmann::json j = read_json(out + "/summary.json");
     CHECK(j["wet"]["newton_projected"] == true);
     CHECK(j["wet"]["bundle_partners"] == 1);
