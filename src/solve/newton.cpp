@@ -228,25 +228,12 @@ private:
     }
 
     // Where the next iteration's ladder starts: one level above this step's. Projected Newton (SolverOptions::projected)
-    // stays on the projected Hessian (assembled alone, without the exact one first) until steps are accepted in full,
-    // then tries the exact Hessian, which full steps suggest is near positive definite: element-wise projection
-    // overstates the stiffness, and near a minimum only the exact Hessian converges quadratically. A failed try costs
-    // a factorization and a second assembly, so after each failure the full projected steps required before the next
-    // try double (up to 16); an accepted full exact step resets them to one.
-    int next_start(int level, double alpha) {
+    // stays on the projected Hessian (assembled alone, without the exact one first) until a step was accepted in full,
+    // then tries the exact Hessian, which a full step suggests is near positive definite: element-wise projection
+    // overstates the stiffness, and near a minimum only the exact Hessian converges quadratically.
+    int next_start(int level, double alpha) const {
         if (!opt_.projected) return std::max(0, std::min(level, 2) - 1);
-        const bool full = alpha == 1;
-        if (level == 0) {
-            if (full) exact_wait_ = 1;
-            full_streak_ = 0;
-            return full ? 0 : 1;
-        }
-        if (start_rung_ == 0) exact_wait_ = std::min(2 * exact_wait_, 16);  // the exact Hessian was tried and failed
-        full_streak_ = full && level == 1 ? full_streak_ + 1 : 0;
-        if (full_streak_ >= exact_wait_) {
-            full_streak_ = 0;
-            return 0;
-        }
+        if (alpha == 1 && level <= 1) return 0;
         return std::max(1, std::min(level, 2) - 1);
     }
 
@@ -311,7 +298,6 @@ private:
     double mu_lm_ = -1;   // Levenberg-Marquardt shift, adapted from the model agreement of each step
     double dm_last_ = 0;  // mean diag of the last iteration's H (the shift is kept relative to it)
     int start_rung_ = 0;
-    int exact_wait_ = 1, full_streak_ = 0;  // projected Newton: full projected steps before the next exact try
     bool projected_ = false, eliminating_ = false;
 };
 }  // namespace
