@@ -1,12 +1,11 @@
 #pragma once
-// The smooth model's partner cap (issue 22; docs/wet.md, "Bundle partners in the smooth model"): the smooth
+// The smooth model's partner cap (issue 22; docs/wet.md, "The partner cap in the smooth model"): the smooth
 // counterpart of the event model's --bundle-partners N.
 //
 // In 2D nothing keeps fibers from stacking on one line, and the contact term is a sum over pairs: a bundle of k
-// collinear fibers holds k(k-1)/2 adhering pairs per length, so the energy falls without bound as fibers pile up
-// (on the 128-fiber beta = 1 example, the capillary energy of a projected-Newton run passed -11700 where the LDL^T
-// path stopped at -1363). The cap saturates each segment's adhesion instead. For segment a with rest length l_a and
-// contact energies C_ab (the pair terms' contact parts, <= 0) with its partners b,
+// collinear fibers holds k(k-1)/2 adhering pairs per length, so the energy falls as fibers pile up and where a solve
+// stops depends on its path (docs/wet.md). The cap saturates each segment's adhesion instead. For segment a with rest
+// length l_a and contact energies C_ab (the pair terms' contact parts, <= 0) with its partners b,
 //   n_a = -sum_b C_ab / (beta l_a)            its partners' share of its length (1: one partner along its length)
 //   E_contact = sum_a -(beta / 2) l_a S(n_a)
 // S(n) = n for n <= N - h (so below the cap the contact energy is the pair sum unchanged, the two halves of each pair
