@@ -159,19 +159,8 @@ TEST_CASE("smooth wet energy: bit for bit the same on any number of threads", "[
     for (const int partners : {0, 1}) {  // without and with the partner cap (a cap of 1 saturates many segments)
         SmoothWetEnergy W(dry, Eigen::Matrix2d::Identity(), smooth(0.3, {}, partners), {}, q);
         REQUIRE(W.bridges(q).size() > 1000);
-        auto evaluate = [&](int threads, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H) {
-            set_thread_count(threads);
-            H = W.hessian_pattern();
-            return W.hessian(q, g, H, false);
-        };
-        Eigen::VectorXd g1, g3;
-        Eigen::SparseMatrix<double> H1, H3;
-        const double e1 = evaluate(1, g1, H1), e3 = evaluate(3, g3, H3);
-        set_thread_count(0);
         INFO("partners " << partners);
-        CHECK(e1 == e3);
-        CHECK((g1.array() == g3.array()).all());
-        CHECK(std::equal(H1.valuePtr(), H1.valuePtr() + H1.nonZeros(), H3.valuePtr()));
+        check_same_on_threads(W, q);
     }
 }
 

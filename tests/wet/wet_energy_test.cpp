@@ -218,21 +218,5 @@ TEST_CASE("wet energy: bit for bit the same on any number of threads", "[wet][pa
     WetEnergy W(dry, Eigen::Matrix2d::Identity(), segment_crossings(m, dry.positions(q, Eigen::Matrix2d::Identity()), m.box.B0()), p);
     REQUIRE(W.bridges().size() > 2048);
     W.set_chunk(1000);
-    auto evaluate = [&](int threads, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H) {
-        set_thread_count(threads);
-        H = W.hessian_pattern();
-        return W.hessian(q, g, H, false);
-    };
-    Eigen::VectorXd g1, g3;
-    Eigen::SparseMatrix<double> H1, H3;
-    const double e1 = evaluate(1, g1, H1), e3 = evaluate(3, g3, H3);
-    set_thread_count(1);
-    const double v1 = W.value(q);
-    set_thread_count(3);
-    const double v3 = W.value(q);
-    set_thread_count(0);
-    CHECK(e1 == e3);
-    CHECK((g1.array() == g3.array()).all());
-    CHECK(std::equal(H1.valuePtr(), H1.valuePtr() + H1.nonZeros(), H3.valuePtr()));
-    CHECK(v1 == v3);
+    check_same_on_threads(W, q);
 }

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "../energy/fd.hpp"
 #include "fibernet/energy/capillary.hpp"
 #include "fibernet/energy/network_energy.hpp"
+#include "fibernet/util/parallel.hpp"
 #include "fibernet/model/discretize.hpp"
 #include "fibernet/network/mikado.hpp"
 #include "fibernet/solve/newton.hpp"
@@ -111,6 +113,28 @@ std::pair<Eigen::MatrixXd, Eigen::MatrixXd> check_against_differences(Energy& W,
     CHECK(fdtest::rel_err(g - gd, fdtest::fd_gradient(capval, q, h), 1e-3) < 1e-6);
     CHECK(fdtest::rel_err(Hcap, fdtest::fd_jacobian(capgrad, q, h), 1e-3) < 1e-5);
     return {Hf, Hcap};
+}
+
+// W's value, energy, gradient and Hessian at q on one thread and on three: the same bits (sums in a fixed order).
+template <class Energy>
+void check_same_on_threads(Energy& W, const Eigen::VectorXd& q) {
+    auto evaluate = [&](int threads, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, double& v) {
+        set_thread_count(threads);
+        H = W.hessian_pattern();
+        const double e = W.hessian(q, g, H, false);
+        v = W.value(q);
+        return e;
+    };
+    Eigen::VectorXd g1, g3;
+    Eigen::SparseMatrix<double> H1, H3;
+    double v1 = 0, v3 = 0;
+    const double e1 = evaluate(1, g1, H1, v1), e3 = evaluate(3, g3, H3, v3);
+    set_thread_count(0);
+    CHECK(e1 == e3);
+    CHECK(v1 == v3);
+    CHECK((g1.array() == g3.array()).all());
+    REQUIRE(H1.nonZeros() == H3.nonZeros());
+    CHECK(std::equal(H1.valuePtr(), H1.valuePtr() + H1.nonZeros(), H3.valuePtr()));
 }
 
 inline Network mikado(double L, double q, double pl, std::uint64_t seed) {
