@@ -142,6 +142,14 @@ struct NetCase {
     std::uint64_t seed;
     bool strict;  // 1e-10 is above this network's round-off floor
 };
+
+Model mikado_model(double L, double q, double pl, std::uint64_t seed, Scheme scheme, double a) {
+    MikadoParams mp;
+    mp.L = L, mp.q = q, mp.pl = pl, mp.seed = seed;
+    DiscretizationParams dp;
+    dp.scheme = scheme, dp.aspect_ratio = a;
+    return discretize(generate_mikado(mp), dp);
+}
 }  // namespace
 
 // max|g| <= 1e-10 is reachable only where the round-off floor of the coordinates is lower: a segment of length l
@@ -155,11 +163,7 @@ TEST_CASE("newton: machine-precision equilibrium on sheared periodic networks, q
         {3, 8, 1.0, 10, Scheme::Even, 7, false},  {3, 8, 1.0, 10, Scheme::Seed, 7, false},
         {4, 8, 0.7, 10, Scheme::Even, 7, false}};
     for (const auto& c : cases) {
-        MikadoParams mp;
-        mp.L = c.L, mp.q = c.q, mp.pl = c.pl, mp.seed = c.seed;
-        DiscretizationParams dp;
-        dp.scheme = c.scheme, dp.aspect_ratio = c.a;
-        const Model m = discretize(generate_mikado(mp), dp);
+        const Model m = mikado_model(c.L, c.q, c.pl, c.seed, c.scheme, c.a);
         NetworkEnergy e(m);
         const Eigen::Matrix2d F = deformation(StrainKind::Shear, 0.01);
         StrainedEnergy obj(e, F);
@@ -202,11 +206,7 @@ TEST_CASE("newton: projected Newton reaches the same equilibrium, quadratically 
     // A sheared Mikado network (compressed segments make element blocks indefinite, so the projected Hessian differs
     // from the exact one): projected Newton (SolverOptions::projected) must end where the default ladder does, and its
     // tail must be quadratic, which only the switch to the exact Hessian after full steps gives.
-    MikadoParams mp;
-    mp.L = 3, mp.q = 8, mp.pl = 1.0, mp.seed = 10;
-    DiscretizationParams dp;
-    dp.scheme = Scheme::Even, dp.aspect_ratio = 7;
-    const Model m = discretize(generate_mikado(mp), dp);
+    const Model m = mikado_model(3, 8, 1.0, 10, Scheme::Even, 7);
     NetworkEnergy e(m);
     const Eigen::Matrix2d F = deformation(StrainKind::Shear, 0.05);
     StrainedEnergy obj(e, F);
