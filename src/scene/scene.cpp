@@ -81,8 +81,6 @@ void Scene::check_values() const {
     check_value(std::isfinite(wet.skin) && wet.skin > 0, wet.skin, source, "[wet].skin", "must be > 0");
     if (wet.model != "smooth" && wet.newton_projected)
         throw InputError(source + ": [wet].newton_projected applies to [wet].model = 'smooth' only");
-    if (wet.model == "smooth" && wet.free_box)
-        throw InputError(source + ": [wet].free_box is not available with [wet].model = 'smooth' yet");
     if (wet.free_box_shape != "full" && wet.free_box_shape != "isotropic")
         throw InputError(source + ": [wet].free_box_shape = '" + wet.free_box_shape +
                          "' is unknown (expected isotropic or full)");

@@ -231,6 +231,27 @@ TEST_CASE("cli wet: --free-box reports the zero-stress box, and exit 1 when it i
     CHECK(k.find("\"status\": \"free_box_not_converged\"") != std::string::npos);
 }
 
+TEST_CASE("cli wet: --free-box on the smooth model", "[wet][cli][free_box][smooth]") {
+    const std::string out = tmpdir() + "/free_smooth";
+    REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
+    // Capillary load on a rigid network: the mean normal stress at the fixed box is well above tolerance, and the
+    // search ends below it, at a stable box (one stiffness eigenvalue, positive), with its modulus.
+    REQUIRE(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --free-box --free-box-tol 1e-4 -o " +
+                out) == 0);
+    const nlohmann::json j = nlohmann::json::parse(slurp(out + "/summary.json"));
+    const nlohmann::json& f = j["runs"][0]["free_box"];
+    INFO(f.dump(1).substr(0, 2000));
+    CHECK(f["converged"] == true);
+    CHECK(f["residual_fixed_box"].get<double>() > 1e-2);
+    CHECK(f["residual"].get<double>() <= 1e-4);
+    REQUIRE(f["stiffness_eigenvalues"].size() == 1);
+    CHECK(f["stiffness_eigenvalues"][0].get<double>() > 0);
+    CHECK(f["shear_modulus"].get<double>() > 0);
+    CHECK(f["bridges"].get<int>() > 0);
+    CHECK(slurp(out + "/sweep.csv").find(",converged,") != std::string::npos);
+    CHECK(slurp(tmpdir() + "/stderr").find("free box iter") != std::string::npos);
+}
+
 TEST_CASE("cli wet: a law file refused leaves a previous run's outputs as they were", "[wet][cli][input]") {
     // A law with a Latin-1 comment left header-only CSVs and deleted the SVGs of the previous run in the directory.
     const std::string out = tmpdir() + "/keep", law = tmpdir() + "/keep_law.txt";
@@ -421,8 +442,6 @@ TEST_CASE("cli wet: the smooth model's options are refused by name", "[wet][cli]
     CHECK(slurp(tmpdir() + "/stderr").find("[wet].skin") != std::string::npos);
     CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --crossing-width -1 -q -o " + out) == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("[wet].crossing_width") != std::string::npos);
-    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --free-box -q -o " + out) == 2);
-    CHECK(slurp(tmpdir() + "/stderr").find("free_box") != std::string::npos);
     CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --bundle-partners -2 -q -o " + out) == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("[wet].bundle_partners = -2") != std::string::npos);
     CHECK(!exists(out));

@@ -1,0 +1,214 @@
+// The free box on the smooth model (free_box.hpp, smooth_free_box.cpp): objective_stress is dE/dF of the smooth
+// energy at fixed q; with beta = 0 the search finds the dry network's stress-free reference; with capillary load it
+// ends at an equilibrium of the whole smooth energy whose stress, recomputed here by finite differences, is below
+// tolerance, and its stiffness (the exact relaxed response) equals the second difference of relaxed energies.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "fibernet/model/discretize.hpp"
+#include "fibernet/wet/wet_run.hpp"
+#include "wet_fixtures.hpp"
+
+using namespace fibernet;
+using namespace wetfix;
+
+namespace {
+// The smooth model's parameters as run_wet resolves them (widths from the fiber's radius 1/a).
+SmoothWetParams resolved(const Model& m, double beta, int partners = 0) {
+    SmoothWetParams p;
+    const double r = 1 / m.aspect_ratio;
+    p.pair.beta = beta, p.pair.crossing_width = r, p.pair.contact = 2 * r, p.pair.overlap_width = r;
+    p.bundle_partners = partners;
+    return p;
+}
+
+double relaxed_energy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, const SmoothWetParams& p,
+                      const FiberPairs& dp, Eigen::VectorXd& q, Solver& s, const SmoothRelaxOptions& ro) {
+    SmoothWetEnergy W(dry, F, p, dp, q);
+    const SmoothRelaxResult r = relax_smooth_wet(W, s, q, ro);
+    REQUIRE(r.converged);
+    return W.value(q);
+}
+
+// P = dE/dF at fixed q by central differences of the smooth energy: independent of its strain derivatives.
+Eigen::Matrix2d fd_P(const NetworkEnergy& dry, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
+                     const SmoothWetParams& p, const FiberPairs& dp, double h = 1e-6) {
+    Eigen::Matrix2d P;
+    for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+            Eigen::Matrix2d Fp = F, Fm = F;
+            Fp(a, b) += h, Fm(a, b) -= h;
+            P(a, b) = (SmoothWetEnergy(dry, Fp, p, dp, q).value(q) - SmoothWetEnergy(dry, Fm, p, dp, q).value(q)) /
+                      (2 * h);
+        }
+    return P;
+}
+
+WetRunOptions options(double beta, bool isotropic, double tol, int partners = 0) {
+    WetRunOptions o;
+    o.model = WetModel::Smooth;
+    o.params.beta = beta;
+    o.smooth.bundle_partners = partners;
+    o.moduli = false;
+    o.solver_options.tol = 1e-10;
+    o.solver_options.max_iter = 500;
+    o.free_box.enabled = true;
+    o.free_box.isotropic = isotropic;
+    o.free_box.tol = tol;
+    return o;
+}
+
+double total_length(const Model& m) {
+    double l = 0;
+    for (const Segment& s : m.segments) l += s.l0;
+    return l;
+}
+
+// The returned state is an equilibrium of the whole smooth energy at F, and its stress from finite differences of
+// the energy along the affine path (P at an equilibrium) is below tolerance in the controlled components.
+void check_smooth_free_box(const Model& m, const FreeBoxResult& f, const SmoothWetParams& p, const FiberPairs& dp,
+                           const FreeBoxOptions& o) {
+    NetworkEnergy dry(m);
+    SmoothWetEnergy W(dry, f.F, p, dp, f.q);
+    Eigen::VectorXd g;
+    W.gradient(f.q, g);
+    CHECK(g.cwiseAbs().maxCoeff() <= 1e-9);
+    const double sc = (p.pair.beta > 0 ? p.pair.beta : 1.0) * total_length(m) /
+                      std::abs((f.F0 * m.box.B0()).determinant());
+    CHECK(f.stress_scale == Approx(sc).epsilon(1e-12));
+    Eigen::Matrix2d P;
+    const double h = 1e-6;
+    for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+            Eigen::Matrix2d Fp = f.F, Fm = f.F;
+            Fp(a, b) += h, Fm(a, b) -= h;
+            const Eigen::VectorXd qp = dry.affine_map(f.q, f.F, Fp), qm = dry.affine_map(f.q, f.F, Fm);
+            P(a, b) = (SmoothWetEnergy(dry, Fp, p, dp, qp).value(qp) - SmoothWetEnergy(dry, Fm, p, dp, qm).value(qm)) /
+                      (2 * h);
+        }
+    const Eigen::Matrix2d sigma = P * f.F.transpose() / std::abs((f.F * m.box.B0()).determinant());
+    INFO("sigma / sigma_c (finite differences) = " << (sigma / sc).format(Eigen::IOFormat(6)));
+    const double margin = 1.05;  // the finite differences' error is far below tol * sigma_c here
+    if (o.isotropic) {
+        CHECK(std::abs(0.5 * (sigma(0, 0) + sigma(1, 1))) <= margin * o.tol * sc);
+        CHECK(f.F.isApprox(f.s * f.F0, 1e-14));
+    } else {
+        CHECK(std::abs(sigma(0, 0)) <= margin * o.tol * sc);
+        CHECK(std::abs(sigma(1, 1)) <= margin * o.tol * sc);
+        CHECK(std::abs(0.5 * (sigma(0, 1) + sigma(1, 0))) <= margin * o.tol * sc);
+    }
+}
+}  // namespace
+
+TEST_CASE("objective_stress: dE/dF of the smooth energy at fixed q, and wet_stress on the event energy",
+          "[wet][free_box][smooth]") {
+    const Network net = mikado(2.5, 6, 0.8, 2);
+    const Model m = model_of(net, 10);
+    NetworkEnergy dry(m);
+    const FiberPairs dp = smooth_dry_pairs(net, {});
+    for (int partners : {0, 1}) {
+        const SmoothWetParams p = resolved(m, 0.7, partners);
+        for (const Eigen::Matrix2d& F : {Eigen::Matrix2d(Eigen::Matrix2d::Identity()),
+                                         Eigen::Matrix2d((Eigen::Matrix2d() << 0.97, 0.04, -0.01, 1.02).finished())}) {
+            INFO("bundle_partners " << partners << ", F = " << F);
+            const Eigen::VectorXd q = perturb(dry.affine_map(dry.dofs(m.x), Eigen::Matrix2d::Identity(), F), 0.05, 7);
+            const SmoothWetEnergy W(dry, F, p, dp, q);
+            const Stress s = objective_stress(W, q);
+            const Eigen::Matrix2d P_fd = fd_P(dry, q, F, p, dp);
+            const Eigen::Matrix2d P_dry = stress(dry, q, F).P;
+            INFO("P = " << s.P << "\nP_fd = " << P_fd << "\nP_dry = " << P_dry);
+            CHECK((s.P - P_dry).norm() > 0.1);  // the capillary term matters here
+            CHECK((s.P - P_fd).norm() <= 1e-6 * P_fd.norm());
+            CHECK(s.sigma.isApprox(s.P * F.transpose() / std::abs((F * m.box.B0()).determinant()), 1e-14));
+            // The event energy through the same route equals its own element sums.
+            WetParams wp;
+            wp.beta = 0.7;
+            const std::vector<Bridge> bridges = wet_crossings(net, m, dry.positions(q, F), F * m.box.B0(), {});
+            const Stress se = objective_stress(WetEnergy(dry, F, bridges, wp), q);
+            const Stress sw = wet_stress(dry, q, F, bridges, wp);
+            CHECK((se.P - sw.P).norm() <= 1e-12 * sw.P.norm());
+        }
+    }
+}
+
+TEST_CASE("smooth free box: beta = 0 finds the unstrained rigid network again", "[wet][free_box][smooth]") {
+    // All crossings crosslinked: the only stress-free states are rigid rotations of the reference, F^T F = I.
+    const Network net = mikado(2.5, 10, 1.0, 4);
+    const Model m = model_of(net, 10);
+    const double tol = 1e-7;
+    SECTION("isotropic, from F0 = 1.02 I: s = 1 / 1.02") {
+        const WetRun r = run_wet(net, m, 1.02 * Eigen::Matrix2d::Identity(), options(0, true, tol));
+        INFO(r.free_box.message);
+        REQUIRE(r.free_box.converged);
+        CHECK(r.free_box.residual0 > 1e-2);
+        CHECK(r.free_box.s == Approx(1 / 1.02).epsilon(1e-6));
+        check_smooth_free_box(m, r.free_box, resolved(m, 0), smooth_dry_pairs(net, {}), options(0, true, tol).free_box);
+    }
+    SECTION("full, from simple shear 0.05: F^T F = I") {
+        Eigen::Matrix2d F0 = Eigen::Matrix2d::Identity();
+        F0(0, 1) = 0.05;
+        const WetRun r = run_wet(net, m, F0, options(0, false, tol));
+        INFO(r.free_box.message);
+        REQUIRE(r.free_box.converged);
+        const Eigen::Matrix2d C = r.free_box.F.transpose() * r.free_box.F;
+        INFO("F^T F = " << C);
+        CHECK((C - Eigen::Matrix2d::Identity()).cwiseAbs().maxCoeff() <= 1e-6);
+        check_smooth_free_box(m, r.free_box, resolved(m, 0), smooth_dry_pairs(net, {}), options(0, false, tol).free_box);
+        REQUIRE(r.free_box.stiffness_eigenvalues.size() == 3);
+        CHECK(r.free_box.stiffness_eigenvalues.minCoeff() > 0);
+    }
+}
+
+TEST_CASE("smooth free box: capillary load moves the box to zero stress, its stiffness the relaxed one",
+          "[wet][free_box][smooth]") {
+    const Network net = mikado(2.5, 6, 0.8, 2);
+    const Model m = model_of(net, 10);
+    const FiberPairs dp = smooth_dry_pairs(net, {});
+    for (int partners : {0, 1}) {
+        INFO("bundle_partners " << partners);
+        const WetRunOptions o = options(0.05, true, 1e-4, partners);
+        const WetRun r = run_wet(net, m, Eigen::Matrix2d::Identity(), o);
+        REQUIRE(r.wet.converged);
+        const FreeBoxResult& f = r.free_box;
+        INFO(f.message << "; s = " << f.s << ", iterations " << f.iterations);
+        REQUIRE(f.converged);
+        CHECK(f.residual0 > 10 * o.free_box.tol);  // the fixed box was under real stress
+        CHECK(!f.F.isApprox(f.F0, 1e-6));
+        CHECK(f.energy.total() < r.wet.energy.total());  // the box gave way
+        const SmoothWetParams p = resolved(m, 0.05, partners);
+        check_smooth_free_box(m, f, p, dp, o.free_box);
+        // The stiffness d2E*/ds2 / A against the second difference of relaxed energies at s (1 +- h) (the relaxed
+        // response is exact; the difference's error is O(h^2) and its rounding E/h^2 1e-16).
+        REQUIRE(f.stiffness_eigenvalues.size() == 1);
+        NetworkEnergy dry(m);
+        auto solver = make_solver("newton", o.solver_options);
+        double E[3];
+        const double h = 1e-4;
+        for (int k = -1; k <= 1; ++k) {
+            const Eigen::Matrix2d Fk = (1 + k * h) * f.F;
+            Eigen::VectorXd qk = dry.affine_map(f.q, f.F, Fk);
+            E[k + 1] = relaxed_energy(dry, Fk, p, dp, qk, *solver, o.smooth_relax);
+        }
+        // d/ds along F = s F0 at s: dF = F0 ds, and (1 + t) F = (s + t s) F0, so d2E*/dt2 = s^2 d2E*/ds2.
+        const double A = std::abs((f.F * m.box.B0()).determinant());
+        const double K_fd = (E[0] - 2 * E[1] + E[2]) / (h * h) / (f.s * f.s) / A;
+        INFO("stiffness " << f.stiffness_eigenvalues[0] << ", second difference " << K_fd);
+        CHECK(f.stiffness_eigenvalues[0] > 0);
+        CHECK(f.stiffness_eigenvalues[0] == Approx(K_fd).epsilon(1e-3));
+    }
+}
+
+TEST_CASE("smooth free box: full box under capillary load on a rigid network", "[wet][free_box][smooth]") {
+    const Network net = mikado(2.5, 10, 1.0, 4);
+    const Model m = model_of(net, 10);
+    const WetRunOptions o = options(0.2, false, 1e-4);
+    const WetRun r = run_wet(net, m, Eigen::Matrix2d::Identity(), o);
+    REQUIRE(r.wet.converged);
+    const FreeBoxResult& f = r.free_box;
+    INFO(f.message);
+    REQUIRE(f.converged);
+    CHECK(f.residual0 > 10 * o.free_box.tol);
+    CHECK(!f.F.isApprox(f.F0, 1e-6));
+    CHECK(f.stiffness_solves <= f.iterations + 2);  // one factorization per accepted state, none per trial
+    check_smooth_free_box(m, f, resolved(m, 0.2), smooth_dry_pairs(net, {}), o.free_box);
+}
