@@ -112,6 +112,15 @@ public:
             return false;
         }
         out = make(u, q, {});
+        // A minimum, not a saddle: its relaxed response (needed next if it is accepted) factors H, and fails where H
+        // is not positive semidefinite.
+        const std::string msg = R_.message;
+        if (!response(out, it.iteration)) {
+            why = "not a minimum: " + R_.message;
+            R_.message = msg;
+            report_unstable(it, Ft, why);
+            return false;
+        }
         return true;
     }
 

@@ -49,9 +49,10 @@ struct FreeBoxOptions {
     int max_iter = 40;           // outer (Newton) iterations
     int max_halvings = 6;
     double max_step = 0.05;      // largest change of a component of U per outer iteration
-    double fd_strain = 1e-4;     // h of the finite-difference relaxed stiffness
+    double fd_strain = 1e-4;     // h of the finite-difference relaxed response (smooth model: of d(sigma)/du alone)
     double snap_width = 1e-7;    // isotropic: a sign-change bracket this narrow (in s) without a root is a snap
-    bool stability = true;       // at a converged box, the relaxed stiffness's eigenvalues (2 x unknowns solves)
+    bool stability = true;       // at a converged box, the relaxed stiffness's eigenvalues (event model: 2 x unknowns
+                                 // solves; smooth model: one factorization)
     bool progress = false;       // one line per outer iteration (and per rejected trial) on stderr
 };
 

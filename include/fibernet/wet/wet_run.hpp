@@ -24,11 +24,11 @@ namespace fibernet {
 // zipped by the active-set loop between solves; active_set.hpp) or the smooth model (one C2 energy over every segment
 // pair within range; smooth_wet_energy.hpp, issue 22).
 enum class WetModel { Events, Smooth };
-WetModel parse_wet_model(const std::string& s);
+WetModel parse_wet_model(const std::string& s);  // "events" | "smooth"; InputError otherwise
+std::string to_string(WetModel m);
 // The dry crossings of the smooth model: the fiber pairs the rule leaves dry and every crosslinked pair (a
 // crosslinked pair gets no capillary term at its crosslink, issue 22).
-FiberPairs smooth_dry_pairs(const Network& net, const WettingRule& rule);  // "events" | "smooth"; InputError otherwise
-std::string to_string(WetModel m);
+FiberPairs smooth_dry_pairs(const Network& net, const WettingRule& rule);
 
 struct WetRunOptions {
     WetParams params;
