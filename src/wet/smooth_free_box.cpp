@@ -100,8 +100,11 @@ public:
     bool trial(const BoxState& S, const Eigen::VectorXd& u, BoxState& out, FreeBoxIteration& it,
                std::string& why) override {
         const Eigen::Matrix2d Ft = stretch_of(u) * F0_;
-        Eigen::VectorXd q = trial_start(S, u, [&](const Eigen::VectorXd& x) { return energy(Ft, x); });
-        SmoothWetEnergy W(dry_, Ft, params_, dry_crossings_, q);
+        // One energy at the trial box for both candidate starts (its values are the whole energy's wherever its list
+        // was built) and the relaxation, its list and pattern rebuilt at the start chosen.
+        SmoothWetEnergy W(dry_, Ft, params_, dry_crossings_, dry_.affine_map(S.q, S.F, Ft));
+        Eigen::VectorXd q = trial_start(S, u, [&](const Eigen::VectorXd& x) { return W.value(x); });
+        W.rebuild(q);
         const SmoothRelaxResult a = relax_smooth_wet(W, solver_, q, relax_);
         ++R_.relaxations, ++it.trials;
         R_.solver_iterations += a.iterations;
@@ -125,10 +128,6 @@ public:
     }
 
 private:
-    double energy(const Eigen::Matrix2d& F, const Eigen::VectorXd& q) const {
-        return SmoothWetEnergy(dry_, F, params_, dry_crossings_, q).value(q);
-    }
-
     const SmoothWetParams& params_;
     const FiberPairs& dry_crossings_;
     const SmoothRelaxOptions& relax_;

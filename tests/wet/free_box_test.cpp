@@ -47,12 +47,6 @@ Eigen::Matrix2d cauchy(const Eigen::Matrix2d& P, const Eigen::Matrix2d& F, const
     return P * F.transpose() / std::abs((F * m.box.B0()).determinant());
 }
 
-double total_length(const Model& m) {
-    double l = 0;
-    for (const Segment& s : m.segments) l += s.l0;
-    return l;
-}
-
 WetRunOptions options(double beta, bool isotropic, double tol) {
     WetRunOptions o;
     o.params.beta = beta;

@@ -59,12 +59,6 @@ WetRunOptions options(double beta, bool isotropic, double tol, int partners = 0)
     return o;
 }
 
-double total_length(const Model& m) {
-    double l = 0;
-    for (const Segment& s : m.segments) l += s.l0;
-    return l;
-}
-
 // The returned state is an equilibrium of the whole smooth energy at F, and its stress from finite differences of
 // the energy along the affine path (P at an equilibrium) is below tolerance in the controlled components.
 void check_smooth_free_box(const Model& m, const FreeBoxResult& f, const SmoothWetParams& p, const FiberPairs& dp,

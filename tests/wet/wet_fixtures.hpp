@@ -52,6 +52,13 @@ inline Eigen::VectorXd perturb(Eigen::VectorXd q, double amp, std::uint64_t seed
     return q;
 }
 
+// The fibers' rest length in the model (the free box's stress scale is beta times it per box area).
+inline double total_length(const Model& m) {
+    double l = 0;
+    for (const Segment& s : m.segments) l += s.l0;
+    return l;
+}
+
 // The symmetric matrix whose upper triangle is `upper`, dense (for small test networks).
 inline Eigen::MatrixXd dense(const Eigen::SparseMatrix<double>& upper) {
     const Eigen::MatrixXd U(upper);
