@@ -51,6 +51,7 @@ public:
     double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool psd) override {
         const double E = f_.hessian(q, g, H, psd);
         energies.push_back(E);
+        restrictions_at.push_back(restrictions);
         return E;
     }
     const Eigen::SparseMatrix<double>& hessian_pattern() const override { return f_.hessian_pattern(); }
@@ -61,6 +62,7 @@ public:
         return nullptr;
     }
     std::vector<double> energies;
+    std::vector<int> restrictions_at;  // restrictions made before each assembly
     int restrictions = 0;
 
 private:
@@ -96,9 +98,16 @@ TEST_CASE("Newton with elimination returns plain Newton's equilibrium of the who
         Eigen::VectorXd g;
         const double E = f.gradient(q, g);
         CHECK(g.lpNorm<Eigen::Infinity>() <= 1e-9);
-        // Energy at every full assembly: non-increasing (local solves and accepted steps only lower it).
+        // Energy at every full assembly: non-increasing (local solves and accepted steps only lower it), up to what
+        // Newton accepts in the round-off regime, a rise of at most 1e-12 (1 + |E|) per accepted step (newton.hpp),
+        // the global step's and each local solve's between the two assemblies (a part's energy is at most E: every
+        // term is >= 0). Rises of 1e-15 relative occur with some CPUs' kernels.
         if (kind < 2)
-            for (size_t k = 1; k < rec.energies.size(); ++k) CHECK(rec.energies[k] <= rec.energies[k - 1]);
+            for (size_t k = 1; k < rec.energies.size(); ++k) {
+                const int steps = 1 + rec.restrictions_at[k] - rec.restrictions_at[k - 1];
+                INFO("assembly " << k << ": " << steps << " solves since the last");
+                CHECK(rec.energies[k] - rec.energies[k - 1] <= 1e-12 * steps * (1 + std::abs(rec.energies[k - 1])));
+            }
         // The same minimum: with max|g| <= 1e-9 on both, the energies differ by O(|g|^2 / stiffness), far below 1e-12.
         CHECK(std::abs(E - plain.energy) <= 1e-12 * std::abs(plain.energy) + 1e-15);
         CHECK(r.factorizations < plain.factorizations);  // the point of it, on this network 30 against 58
