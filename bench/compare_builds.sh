@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Do two builds give the same results? Runs relax (plain, --eliminate, --ldl, every other solver), modulus and a
+# Do two builds give the same results? Runs relax (plain, with elimination, --ldl, every other solver), modulus and a
 # wet run on small scenes with each executable and compares their JSON (timings, paths and provenance removed) and
 # the wet state file byte for byte. For a change that must not move any result (a refactoring; docs/solvers.md,
 # "One loop, one registry, one linear-solver interface").
@@ -27,8 +27,11 @@ run_all() {
     local exe=$1 out=$2 s
     mkdir -p "$out"
     cd "$root" || exit 2
-    "$exe" relax problems/default.toml --L 10 --gamma 0.01 --prune dangling ends -q | strip > "$out/relax_plain.json"
-    "$exe" relax problems/default.toml --L 10 --gamma 0.01 --prune dangling ends --eliminate -q | strip > "$out/relax_eliminate.json"
+    # Elimination is the default since 2026-12-04; an executable from before that has no --no-eliminate and runs plain.
+    local plain=(--no-eliminate) elim=()
+    "$exe" relax --help | grep -q -- --no-eliminate || plain=() elim=(--eliminate)
+    "$exe" relax problems/default.toml --L 10 --gamma 0.01 --prune dangling ends "${plain[@]}" -q | strip > "$out/relax_plain.json"
+    "$exe" relax problems/default.toml --L 10 --gamma 0.01 --prune dangling ends "${elim[@]}" -q | strip > "$out/relax_eliminate.json"
     "$exe" relax problems/default.toml --L 10 --gamma 0.05 --ldl -q 2>/dev/null | strip > "$out/relax_ldl.json"
     "$exe" modulus problems/default.toml --L 8 -q | strip > "$out/modulus.json"
     for s in lbfgs lbfgs-hessian cg fire nlopt-lbfgs ipopt; do

@@ -2,7 +2,7 @@
 """Where Newton's iterations go: reads the per-iteration lines of `fibernet relax ... -v` (stderr) and prints the
 first iteration below each max|g| level, then every 10th iteration's energy above the last, max|g| and step.
 
-    build/fibernet relax problems/default.toml --L 80 --gamma 0.01 --prune dangling ends --eliminate -v \\
+    build/fibernet relax problems/default.toml --L 80 --gamma 0.01 --prune dangling ends -v \\
         2> l80.err > l80.json
     /usr/bin/python3 bench/newton_history.py l80.err
 """

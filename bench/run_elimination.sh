@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Nonlinear elimination against plain Newton (issue 23; docs/solvers.md "Nonlinear elimination"): the default scene's
 # network grown to L (q = 8, pl = 1, seed SEED, even scheme), dangling fibers and end arms pruned, simple shear
-# gamma = 0.01 from the affine start, Newton to tol 1e-10 (or its round-off floor), with and without --eliminate.
+# gamma = 0.01 from the affine start, Newton to tol 1e-10 (or its round-off floor), with elimination (the default since
+# 2026-12-04) and without it (--no-eliminate).
 # One row per (L, method): global iterations and factorizations, the local solves' counts, seconds, max|g| and the
 # stress, so the two equilibria can be compared.
 #   bench/run_elimination.sh                # L = 10 20 40
@@ -14,7 +15,7 @@ printf "L\tseed\tmethod\tdofs\tstatus\titerations\tfactorizations\tlocal_solves\
 for L in ${LS:-10 20 40}; do
     for method in ${METHODS:-plain eliminate}; do
         flags=()
-        [ "$method" = eliminate ] && flags=(--eliminate)
+        [ "$method" = plain ] && flags=(--no-eliminate)
         load=$(cut -d' ' -f1 /proc/loadavg)
         rc=0
         json=$("$exe" relax "$root/problems/default.toml" --L "$L" --seed "${SEED:-1}" --gamma "${GAMMA:-0.01}" \

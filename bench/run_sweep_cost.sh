@@ -9,7 +9,8 @@
 #   LS="5 10" PRUNES="none" bench/run_sweep_cost.sh
 # Environment: FIBERNET (executable, default build/fibernet), OUT (default docs/sweep), LS, PRUNES ("none" and/or
 # "dangling,ends"), GAMMA_MAX (0.05), STEP (0.01), MIN_STEP (1e-3), TIME_LIMIT (seconds per sweep, 600),
-# SOLVER_FLAGS (extra flags for every sweep, e.g. "--eliminate"; docs/solvers.md "Nonlinear elimination").
+# SOLVER_FLAGS (extra flags for every sweep, e.g. "--no-eliminate" for plain Newton, the default until 2026-12-04;
+# docs/solvers.md "Nonlinear elimination").
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 exe=${FIBERNET:-$root/build/fibernet}

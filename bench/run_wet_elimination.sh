@@ -15,7 +15,7 @@ trap 'rm -rf "$work"' EXIT
 printf "fibers\tbeta\tmethod\tstatus\trounds\tsolver_iterations\tlocal_solves_last\tE_wet\tseconds_wet_solve\tseconds\n"
 for method in ${METHODS:-plain eliminate}; do
     flags=()
-    [ "$method" = eliminate ] && flags=(--eliminate)
+    [ "$method" = eliminate ] && flags=(--wet-eliminate)  # [wet] newton_eliminate (before 2026-12-04: --eliminate)
     rc=0
     "$exe" wet --network "$work/w.net" --betas "${BETA:-1}" --no-moduli -o "$work/$method" -q "${flags[@]}" \
         > "$work/$method.json" || rc=$?

@@ -4,7 +4,7 @@
 One case is one random network (L uniform in (2, 5], q in [4, 12], pl in [0.3, 1], scheme seed|even, periodic or
 --open, a random seed), run through every command of --commands (default modulus,sweep,wet), one process at a time;
 --every wet=K runs a command only on every K-th case, --flags CMD=FLAGS adds flags to a command (e.g.
-modulus=--eliminate), --round-robin runs case i through one command only (command
+modulus=--no-eliminate), --round-robin runs case i through one command only (command
 i mod the number of commands). Commands:
 
   modulus  fibernet modulus NET -q [--gamma 0.01 on one case in five]
@@ -307,7 +307,7 @@ def main():
                     help="directory for failing reproducers (default %(default)s)")
     ap.add_argument("--commands", default=",".join(COMMANDS), help="comma-separated subset of modulus,sweep,wet")
     ap.add_argument("--flags", action="append", default=[], metavar="CMD=FLAGS",
-                    help="extra flags for a command, e.g. modulus=--eliminate (space-separated; repeatable)")
+                    help="extra flags for a command, e.g. modulus=--no-eliminate (space-separated; repeatable)")
     ap.add_argument("--round-robin", action="store_true", help="case i runs only command i mod len(commands)")
     ap.add_argument("--every", action="append", default=[], metavar="CMD=K",
                     help="run CMD only on every K-th case (e.g. wet=3); repeatable")

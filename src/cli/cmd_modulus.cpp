@@ -59,8 +59,8 @@ void register_modulus(CLI::App& app) {
         if (*verbose && *quiet) throw InputError("--verbose and --quiet contradict each other");
         const auto t_all = std::chrono::steady_clock::now();
         Scene s = flags->resolve();
-        SolverOptions so;
-        so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.eliminate = s.solver.eliminate, so.verbose = *verbose;
+        SolverOptions so = dry_solver_options(s);
+        so.verbose = *verbose;
         auto solver = make_solver(s.solver.name, so);  // unknown name: InputError before any work
 
         auto t0 = std::chrono::steady_clock::now();

@@ -34,8 +34,8 @@ void register_relax(CLI::App& app) {
         if (*verbose && *quiet) throw InputError("--verbose and --quiet contradict each other");
         Scene s = flags->resolve();
         check_outputs({{"--output", *out}});  // before the solve, not after it
-        SolverOptions so;
-        so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.eliminate = s.solver.eliminate, so.verbose = *verbose;
+        SolverOptions so = dry_solver_options(s);
+        so.verbose = *verbose;
         auto solver = make_solver(s.solver.name, so);
         Network net = scene_network(s);
         Model m = discretize(net, s.discretization);

@@ -288,8 +288,7 @@ void register_sweep(CLI::App& app) {
         const nlohmann::json params = sweep_parameters(s, *p);
         Checkpoint c;
         if (*resume) c = read_checkpoint(*ckpt, params, *p);  // before any work: a mismatch costs nothing
-        SolverOptions so;
-        so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.eliminate = s.solver.eliminate;
+        const SolverOptions so = dry_solver_options(s);
         auto solver = make_solver(s.solver.name, so);
         SolverOptions so_snap = so;  // the snap-through budget at the smallest step (docs/sweep.md)
         so_snap.max_iter = 10 * so.max_iter;

@@ -263,6 +263,9 @@ void register_wet(CLI::App& app) {
         const auto t_all = std::chrono::steady_clock::now();
         Scene s = flags->resolve(false);  // checked whole below, with the [wet] flags in
         refuse_trimmed_ends(s, "wet", "capillary bridges sit on the end arms");
+        if (flags->given("--eliminate"))  // else silently without effect here
+            throw InputError("command line: --eliminate and --no-eliminate set the dry solves' [solver] eliminate; the "
+                             "wet relaxation's is --wet-eliminate ([wet] newton_eliminate, off by default)");
         if (flags->scene_file.empty() && !flags->given("--pl")) s.mikado.pl = 0.5;  // the thesis's wet networks
         s.source = flags->scene_file.empty() ? "command line" : flags->scene_file + " + command line";
         s.check();
@@ -282,7 +285,7 @@ void register_wet(CLI::App& app) {
         opt.rule.fraction = s.wet.fraction, opt.rule.seed = s.wet.seed;
         opt.solver = s.solver.name;
         opt.solver_options.tol = s.solver.tol, opt.solver_options.max_iter = s.solver.max_iter;
-        opt.solver_options.eliminate = s.solver.eliminate;
+        opt.solver_options.eliminate = s.wet.newton_eliminate;
         opt.solver_options.verbose = w->verbose;
         opt.active_set.verbose = w->verbose || !w->quiet;
         opt.active_set.max_rounds = s.wet.max_rounds;
@@ -397,7 +400,7 @@ void register_wet(CLI::App& app) {
                                 {"strain", to_string(s.strain)},
                                 {"gamma", s.gamma},
                                 {"solver", {{"name", s.solver.name}, {"tol", s.solver.tol}, {"max_iter", s.solver.max_iter},
-                                            {"eliminate", s.solver.eliminate}}},
+                                            {"eliminate", s.wet.newton_eliminate}}},
                                 {"runs", runs},
                                 {"complete", complete},
                                 {"seconds", seconds_since(t_all)}};

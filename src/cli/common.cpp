@@ -19,6 +19,7 @@
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/scene/scene_options.hpp"
 #include "fibernet/scene/scene_toml.hpp"
+#include "fibernet/solve/solver_registry.hpp"
 #include "fibernet/util/error.hpp"
 #include "fibernet_version.hpp"
 
@@ -105,7 +106,8 @@ void SceneFlags::add(CLI::App* app, bool with_load, bool with_wet) {
         std::string doc = o.doc;
         const std::string shown = o.literal(defaults);  // no default shown for a switch or an empty text
         if (o.kind != OptionKind::Boolean && shown != "\"\"") doc += " (default " + shown + ")";
-        CLI::Option* cli = o.kind == OptionKind::Boolean ? app->add_flag(o.flag, switches[o.flag], doc)
+        const std::string names = o.negation.empty() ? o.flag : o.flag + ",!" + o.negation;
+        CLI::Option* cli = o.kind == OptionKind::Boolean ? app->add_flag(names, switches[o.flag], doc)
                                                          : app->add_option(o.flag, values[o.flag], doc);
         if (o.kind == OptionKind::Real) cli->type_name("NUMBER");
         if (o.kind == OptionKind::Integer) cli->type_name("INT");
@@ -151,9 +153,19 @@ Scene SceneFlags::resolve(bool complete) const {
             if (given(g))
                 throw InputError(std::string("command line: ") + g + " has no effect on a saved network ('" +
                                  s.network_file + "' gives the box and the fibers); remove " + g);
+    // Asked for by name, elimination must act (a scene file's key, on by default, is ignored by solvers without it).
+    if (given("--eliminate") && s.solver.eliminate && !solver_capabilities(s.solver.name).eliminate)
+        throw InputError("command line: --eliminate needs a solver with nonlinear elimination (newton); solver is '" +
+                         s.solver.name + "'");
     if (complete) s.check(), record_scene(s);
     else s.check_values();
     return s;
+}
+
+SolverOptions dry_solver_options(const Scene& s) {
+    SolverOptions so;
+    so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.eliminate = s.solver.eliminate;
+    return so;
 }
 
 nlohmann::json to_json(const NetworkStats& s) {

@@ -17,6 +17,7 @@
 #include "fibernet/network/network.hpp"
 #include "fibernet/scene/scene.hpp"
 #include "fibernet/solve/result.hpp"
+#include "fibernet/solve/solver.hpp"
 
 namespace fibernet::cli {
 
@@ -63,6 +64,8 @@ void refuse_periodic(const Scene& s, const Network& net, const std::string& need
 
 // Commands whose physics acts on fiber end arms (bridges, clamps, rods) refuse `prune ends` with an InputError.
 void refuse_trimmed_ends(const Scene& s, const std::string& command, const std::string& why);
+// The dry solves' solver options (relax, modulus, sweep) from the scene's [solver] table.
+SolverOptions dry_solver_options(const Scene& s);
 
 nlohmann::json to_json(const NetworkStats& s);
 nlohmann::json prune_rules(const Scene& s);  // the pruning rules applied, e.g. ["dangling", "ends"]

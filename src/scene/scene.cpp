@@ -30,10 +30,11 @@ void Scene::check() const {
     if (wet.crossings != "fraction" && wet.seed != 1)  // the seed of that draw, likewise (--wet-seed)
         throw InputError(source + ": [wet].seed = " + std::to_string(wet.seed) + " is used only with crossings = "
                          "fraction (crossings is '" + wet.crossings + "')");
-    // Else silently ignored by the solver (an unknown solver is named here too).
-    if (solver.eliminate && !solver_capabilities(solver.name).eliminate)
-        throw InputError(source + ": solver.eliminate = true needs a solver with nonlinear elimination (newton); solver "
-                         "is '" + solver.name + "'");
+    solver_entry(solver.name);  // an unknown solver is named here
+    // The wet relaxation's elimination would otherwise be silently ignored by the solver.
+    if (wet.newton_eliminate && !solver_capabilities(solver.name).eliminate)
+        throw InputError(source + ": [wet].newton_eliminate = true needs a solver with nonlinear elimination (newton); "
+                         "solver is '" + solver.name + "'");
     check_beta(wet.beta, source, "[wet].beta");
     // The law file last: a --law flag replaces the scene's before any file is opened.
     if (!wet.law.empty()) {

@@ -100,9 +100,13 @@ std::vector<SceneOption> declare() {
     add(text("solver", "name", "--solver", "solver", [](Scene& s) -> std::string& { return s.solver.name; }));
     add(real("solver", "tol", "--tol", "max |gradient| to stop at", [](Scene& s) -> double& { return s.solver.tol; }));
     add(integer("solver", "max_iter", "--max-iter", "iteration limit", [](Scene& s) -> int& { return s.solver.max_iter; }));
-    add(boolean("solver", "eliminate", "--eliminate",
-                "Newton: solve the hot places to local equilibrium before and inside each global step (docs/solvers.md)",
-                [](Scene& s) -> bool& { return s.solver.eliminate; }));
+    SceneOption eliminate = boolean(
+        "solver", "eliminate", "--eliminate",
+        "Newton (relax, modulus, sweep): solve the hot places to local equilibrium before and inside each global step; "
+        "on by default, --no-eliminate: plain Newton (docs/solvers.md)",
+        [](Scene& s) -> bool& { return s.solver.eliminate; });
+    eliminate.negation = "--no-eliminate";
+    add(eliminate);
     // [wet] (docs/wet.md)
     add(real("wet", "beta", "--beta", "adhesion per unit bundle length, bending units",
              [](Scene& s) -> double& { return s.wet.beta; }));
@@ -131,6 +135,9 @@ std::vector<SceneOption> declare() {
                 "smooth model: projected Newton (element-wise PSD Hessian until full steps, then exact) instead of "
                 "newton_ldl (docs/wet.md)",
                 [](Scene& s) -> bool& { return s.wet.newton_projected; }));
+    add(boolean("wet", "newton_eliminate", "--wet-eliminate",
+                "Newton's nonlinear elimination in the wet relaxation (off by default: docs/solvers.md)",
+                [](Scene& s) -> bool& { return s.wet.newton_eliminate; }));
     add(real("wet", "local_fraction", "", "local rounds: largest part of the coordinates",
              [](Scene& s) -> double& { return s.wet.local_fraction; }));
     add(real("wet", "local_threshold", "", "local rounds: hot where |g| > threshold x max|g|",

@@ -47,7 +47,10 @@ TEST_CASE("cli: bad input exits 2, names the value and writes no output file", "
         {"generate --seed 18446744073709551616", "seed 18446744073709551616 is not an integer"},
         {"relax --L 3 --q 5 --strain uniaxial --gamma -2", "gamma = -2 flips or collapses the box"},
         {"relax --L 3 --q 5 --strain isotropic --gamma -3", "gamma = -3 flips or collapses the box"},
-        {"relax --L 3 --q 5 --gamma 0.01 --solver lbfgs --eliminate", "eliminate = true needs a solver with nonlinear elimination"},
+        {"relax --L 3 --q 5 --gamma 0.01 --solver lbfgs --eliminate", "--eliminate needs a solver with nonlinear elimination"},
+        // The dry solves' elimination flag would do nothing in a wet run: the message names the wet one.
+        {"wet --L 2.5 --q 5 --betas 0 --no-eliminate", "the wet relaxation's is --wet-eliminate"},
+        {"wet --L 2.5 --q 5 --betas 0 --solver lbfgs --wet-eliminate", "newton_eliminate = true needs a solver with nonlinear"},
     };
     for (const auto& c : cases) {
         std::remove(out.c_str());

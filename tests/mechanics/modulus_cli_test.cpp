@@ -169,12 +169,15 @@ TEST_CASE("cli relax: writes the equilibrium model and its stress", "[cli][relax
     CHECK_FALSE(std::ifstream(bad).good());
 }
 
-TEST_CASE("cli relax --eliminate: the same equilibrium stress with fewer global factorizations", "[cli][relax]") {
+TEST_CASE("cli relax: elimination by default, the same equilibrium stress as --no-eliminate with fewer global "
+          "factorizations", "[cli][relax]") {
     const std::string scene = "relax " + std::string(FIBERNET_SOURCE_DIR) +
                               "/problems/default.toml --prune dangling ends --gamma 0.01 --tol 1e-9";
-    REQUIRE(run(scene) == 0);
+    REQUIRE(run(scene + " --no-eliminate") == 0);
     const auto plain = out();
-    REQUIRE(run(scene + " --eliminate") == 0);
+    CHECK(plain["solver"]["local_solves"].get<int>() == 0);
+    CHECK(plain["provenance"]["scene_toml"].get<std::string>().find("eliminate = false") != std::string::npos);
+    REQUIRE(run(scene) == 0);
     const auto el = out();
     CHECK(el["status"] == "converged");
     CHECK(el["solver"]["grad_max"].get<double>() <= 1e-9);

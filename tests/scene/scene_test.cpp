@@ -28,6 +28,12 @@ TEST_CASE("scene: values are read and defaults kept", "[scene]") {
     CHECK(s.gamma == 0.01);
     CHECK(s.solver.tol == 1e-9);
     CHECK(s.solver.name == "newton");
+    // Nonlinear elimination: on for the dry solves, off for the wet relaxation, unless a scene says otherwise.
+    CHECK(s.solver.eliminate);
+    CHECK_FALSE(s.wet.newton_eliminate);
+    const Scene t = parse_scene("[solver]\neliminate = false\n[wet]\nnewton_eliminate = true\n", "t.toml");
+    CHECK_FALSE(t.solver.eliminate);
+    CHECK(t.wet.newton_eliminate);
 }
 
 TEST_CASE("scene: bad scenes name the file, key and value", "[scene][input]") {

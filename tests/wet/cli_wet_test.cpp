@@ -290,7 +290,7 @@ TEST_CASE("cli wet: summary.json records what reproduces the run", "[wet][cli]")
     // Every [wet] setting away from its default, so that each recorded value is this run's.
     write(scene, "[network]\nL = 2.5\nq = 8\npl = 1\nseed = 3\n[wet]\ncrossings = \"fraction\"\nfraction = 0.5\n"
                  "max_rounds = 50\nround_iterations = 0\nnewton_ldl = false\nlocal_fraction = 0\n"
-                 "local_threshold = 0.2\nlocal_hops = 1\n");
+                 "local_threshold = 0.2\nlocal_hops = 1\nnewton_eliminate = true\n");
     REQUIRE(run(scene + " --wet-seed 5 --law " + law + " --betas 0,0 --no-moduli -q -o " + out) == 0);
     const nlohmann::json j = read_json(out + "/summary.json");
     REQUIRE(j.is_object());
@@ -309,7 +309,7 @@ TEST_CASE("cli wet: summary.json records what reproduces the run", "[wet][cli]")
     CHECK(w["law_table"] == law_text);  // the table itself: the file may change or be gone
     CHECK(w["law_fnv1a"].is_number_unsigned());
     CHECK(w["moduli"] == false);
-    CHECK(j["solver"] == nlohmann::json({{"name", "newton"}, {"tol", 1e-10}, {"max_iter", 500}, {"eliminate", false}}));
+    CHECK(j["solver"] == nlohmann::json({{"name", "newton"}, {"tol", 1e-10}, {"max_iter", 500}, {"eliminate", true}}));
     CHECK(j["prune"] == nlohmann::json::array());
     CHECK(j["parameters"]["seed"] == 3);
     // The default law is named, with no table.

@@ -17,7 +17,10 @@ struct SolverSettings {
     std::string name = "newton";
     double tol = 1e-10;        // max |gradient| in seed units
     int max_iter = 500;
-    bool eliminate = false;    // Newton: nonlinear elimination (solve/nonlinear_elimination.hpp)
+    // Newton's nonlinear elimination (solve/nonlinear_elimination.hpp) in the dry solves (relax, modulus, sweep): on by
+    // default since it reaches the same equilibria with 2-10x fewer global factorizations (docs/solvers.md); solvers
+    // without it ignore the key. The wet relaxation has its own, [wet] newton_eliminate.
+    bool eliminate = true;
 };
 
 // [wet] (docs/formats.md, "Wet scenes"; issue 6): capillary bridges for `fibernet wet`. Plain values here; the wet
@@ -35,6 +38,9 @@ struct WetSettings {
     int round_iterations = 10;  // Newton iterations per round while the set changes (0: solve each round to the end)
     bool newton_ldl = true;     // Newton's first rung by LDL^T with flipped negative pivots (docs/wet.md)
     bool newton_projected = false;  // smooth model: projected Newton (SolverOptions::projected) instead of newton_ldl
+    // Newton's nonlinear elimination in the wet relaxation: off, since on a landscape with many minima (zipping) it
+    // commits the hot places to their nearest valley and gains nothing on the event model (docs/solvers.md).
+    bool newton_eliminate = false;
     // Local rounds (docs/wet.md, "Local rounds"): the part of the network that needs a solve, if it holds at most
     // local_fraction of the coordinates (0: every round global); hot: |g| > local_threshold x max|g|, grown by local_hops.
     double local_fraction = 0.25;

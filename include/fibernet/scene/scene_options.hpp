@@ -31,6 +31,7 @@ struct SceneOption {
     std::function<void(Scene&, const std::string&)> set_choice;
     std::function<std::string(const Scene&)> get_choice;
     bool flag_sets_false = false;  // a Boolean whose flag turns it off (--open: periodic = false)
+    std::string negation;          // a Boolean's second flag, which turns it off (--no-eliminate); empty: none
     bool existing_file = false;    // a Text that names a file which must exist (checked when the flag is parsed)
 
     std::string name() const { return table + "." + key; }
