@@ -8,7 +8,7 @@ Networks, models and states are numpy arrays; the jobs are the command-line tool
     r["G"], r["G_error"], r["G_affine"]
 
 Every scene key is a keyword (L, q, pl, seed, open, scheme, n_seg, h, a, prune, gamma, strain, solver, tol,
-max_iter; docs/formats.md "Scene"), and so is every flag of the command (underscores for dashes: gamma_max=0.1
+max_iter, eliminate; docs/formats.md "Scene"), and so is every flag of the command (underscores for dashes: gamma_max=0.1
 for --gamma-max). A scene file may be given first. Bad input raises ValueError naming the value and writes
 nothing. A solve that did not converge is not an error: the result's "status" says so, and its state is None.
 """
@@ -122,6 +122,9 @@ def _argv(command, scene, options):
         argv.append(os.fspath(scene))
     for key, value in options.items():
         flag = _FLAG_NAMES.get(key, "--" + key.replace("_", "-"))
+        if value is False and "no-" + flag[2:] in known:  # a switch that is on by default: eliminate=False
+            argv.append("--no-" + flag[2:])
+            continue
         if value is None or value is False:
             continue
         if value is True:

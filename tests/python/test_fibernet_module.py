@@ -87,6 +87,16 @@ def test_relax_state_is_exact():
     assert e["gradient"].shape == (st.model.num_nodes, 2)
 
 
+def test_elimination_is_on_by_default_and_off_with_false():
+    # A switch that is on by default turns off with False (--no-eliminate), not silently left on.
+    scene = dict(L=10, q=8, pl=1, seed=1, scheme="even", prune=["dangling", "ends"], gamma=0.01, tol=1e-9)
+    on, off = fn.relax(**scene), fn.relax(**scene, eliminate=False)
+    assert on["status"] == off["status"] == "converged"
+    assert on["solver"]["local_solves"] > 0 and off["solver"]["local_solves"] == 0
+    assert "eliminate = false" in off["provenance"]["scene_toml"]
+    assert off["stress"]["xy"] == pytest.approx(on["stress"]["xy"], rel=1e-9)  # one minimum, both at max|g| <= 1e-9
+
+
 def test_not_converged_is_a_status_not_a_state():
     r = fn.relax(**SCENE, gamma=0.2, max_iter=1)
     assert r["status"] != "converged" and r["exit_code"] == 1
