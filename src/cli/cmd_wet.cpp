@@ -266,9 +266,6 @@ void register_wet(CLI::App& app) {
         if (flags->given("--eliminate"))  // else silently without effect here
             throw InputError("command line: --eliminate and --no-eliminate set the dry solves' [solver] eliminate; the "
                              "wet relaxation's is --wet-eliminate ([wet] newton_eliminate, off by default)");
-        if (flags->given("--diagonal-shift"))
-            throw InputError("command line: --diagonal-shift sets the dry solves' [solver] diagonal_shift; the wet "
-                             "relaxation's Newton shifts by mu I");
         if (flags->scene_file.empty() && !flags->given("--pl")) s.mikado.pl = 0.5;  // the thesis's wet networks
         s.source = flags->scene_file.empty() ? "command line" : flags->scene_file + " + command line";
         s.check();

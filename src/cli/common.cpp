@@ -165,7 +165,6 @@ Scene SceneFlags::resolve(bool complete) const {
 SolverOptions dry_solver_options(const Scene& s) {
     SolverOptions so;
     so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.eliminate = s.solver.eliminate;
-    so.diagonal_shift = s.solver.diagonal_shift;
     return so;
 }
 

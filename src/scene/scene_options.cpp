@@ -107,10 +107,6 @@ std::vector<SceneOption> declare() {
         [](Scene& s) -> bool& { return s.solver.eliminate; });
     eliminate.negation = "--no-eliminate";
     add(eliminate);
-    add(boolean("solver", "diagonal_shift", "--diagonal-shift",
-                "Newton (relax, modulus, sweep): Levenberg-Marquardt shift relative to each diagonal entry of the "
-                "Hessian instead of one for all; pays on the seed scheme (docs/solvers.md \"Diagonal shift\")",
-                [](Scene& s) -> bool& { return s.solver.diagonal_shift; }));
     // [wet] (docs/wet.md)
     add(real("wet", "beta", "--beta", "adhesion per unit bundle length, bending units",
              [](Scene& s) -> double& { return s.wet.beta; }));

@@ -196,7 +196,7 @@ private:
         if (mu_lm_ < 0) mu_lm_ = (opt_.warm_start && warm_shift_rel_ > 0 ? warm_shift_rel_ : kMuStart) * dm;
         dm_last_ = dm;
         const double mu = std::max(kMuFloor * dm, mu_lm_);
-        LadderState ls{run.objective(), q, g_, H_, projected_, mu, dm, 0, r, opt_.diagonal_shift};
+        LadderState ls{run.objective(), q, g_, H_, projected_, mu, dm, 0, r};
         int level = -1;
         double shift = 0, alpha = 1, ft = 0;
         bool accepted = false, retried = false, step_ldl = false;

@@ -20,30 +20,9 @@ bool LadderState::descent(const Eigen::VectorXd& d) const {
     return d.allFinite() && g.dot(d) < -kDescent * g.norm() * d.norm();
 }
 
-const Eigen::SparseMatrix<double>& LadderState::shifted(double s, double& shift_out) {
-    if (!diagonal) {
-        shift_out = s;
-        return H;
-    }
-    scaled = H;
-    const double rel = s / dm, lo = 1e-8 * dm;
-    for (int j = 0; j < scaled.cols(); ++j) {  // upper triangle: the diagonal is each column's last entry
-        const int e = scaled.outerIndexPtr()[j + 1] - 1;
-        if (e < scaled.outerIndexPtr()[j] || scaled.innerIndexPtr()[e] != j) {  // no diagonal entry to scale
-            shift_out = s;
-            return H;
-        }
-        scaled.valuePtr()[e] += rel * std::max(std::abs(scaled.valuePtr()[e]), lo);
-    }
-    shift_out = 0;
-    return scaled;
-}
-
 bool LadderState::factor_and_solve(LinearSolver& lin, double shift, Eigen::VectorXd& d) {
     const auto tf = std::chrono::steady_clock::now();
-    double s = 0;
-    const Eigen::SparseMatrix<double>& M = shifted(shift, s);
-    const bool ok = lin.factorize(M, s);
+    const bool ok = lin.factorize(H, shift);
     result.timings.factorization += since(tf);
     ++result.factorizations;
     if (!ok) return false;

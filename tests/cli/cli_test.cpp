@@ -50,7 +50,6 @@ TEST_CASE("cli: bad input exits 2, names the value and writes no output file", "
         {"relax --L 3 --q 5 --gamma 0.01 --solver lbfgs --eliminate", "--eliminate needs a solver with nonlinear elimination"},
         // The dry solves' elimination flag would do nothing in a wet run: the message names the wet one.
         {"wet --L 2.5 --q 5 --betas 0 --no-eliminate", "the wet relaxation's is --wet-eliminate"},
-        {"wet --L 2.5 --q 5 --betas 0 --diagonal-shift", "the wet relaxation's Newton shifts by mu I"},
         {"wet --L 2.5 --q 5 --betas 0 --solver lbfgs --wet-eliminate", "newton_eliminate = true needs a solver with nonlinear"},
     };
     for (const auto& c : cases) {

@@ -31,7 +31,6 @@ TEST_CASE("scene: values are read and defaults kept", "[scene]") {
     // Nonlinear elimination: on for the dry solves, off for the wet relaxation, unless a scene says otherwise.
     CHECK(s.solver.eliminate);
     CHECK_FALSE(s.wet.newton_eliminate);
-    CHECK_FALSE(s.solver.diagonal_shift);
     const Scene t = parse_scene("[solver]\neliminate = false\n[wet]\nnewton_eliminate = true\n", "t.toml");
     CHECK_FALSE(t.solver.eliminate);
     CHECK(t.wet.newton_eliminate);

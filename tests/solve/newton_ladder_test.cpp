@@ -121,31 +121,3 @@ TEST_CASE("newton ladder: when the shift cap is too low for the exact Hessian, t
     CHECK(s.projected);
     CHECK(st.descent(d));
 }
-
-TEST_CASE("newton ladder: the diagonal shift adds s / dm max(|H_jj|, 1e-8 dm) to each diagonal entry", "[solve][newton]") {
-    Setup s(1.1, 1.2);
-    LadderState st = s.state(0);
-    const double dm = st.dm, shift = 1e-3;
-    double out = -1;
-    CHECK(&st.shifted(shift, out) == &s.H);  // mu I: H itself, shifted by the factorization
-    CHECK(out == shift);
-    st.diagonal = true;
-    const Eigen::SparseMatrix<double>& M = st.shifted(shift, out);
-    CHECK(out == 0);
-    const Eigen::MatrixXd A = Eigen::MatrixXd(s.H), B = Eigen::MatrixXd(M);
-    for (int i = 0; i < A.rows(); ++i)
-        for (int j = 0; j < A.cols(); ++j) {
-            const double expect = A(i, j) + (i == j ? shift / dm * std::max(std::abs(A(i, i)), 1e-8 * dm) : 0.0);
-            CHECK(B(i, j) == Approx(expect).epsilon(1e-15));
-        }
-    // A column without a diagonal entry has nothing to scale: the shift is s I then.
-    Eigen::SparseMatrix<double> H(2, 2);
-    H.insert(0, 0) = 2, H.insert(0, 1) = 1;
-    H.makeCompressed();
-    Eigen::VectorXd g = Eigen::VectorXd::Zero(2);
-    bool projected = false;
-    SolveResult r;
-    LadderState bare{s.f, s.q, g, H, projected, 0, 1.0, 0, r, true};
-    CHECK(&bare.shifted(shift, out) == &H);
-    CHECK(out == shift);
-}

@@ -21,10 +21,6 @@ struct SolverSettings {
     // default since it reaches the same equilibria with 2-10x fewer global factorizations (docs/solvers.md); solvers
     // without it ignore the key. The wet relaxation has its own, [wet] newton_eliminate.
     bool eliminate = true;
-    // Newton's Levenberg-Marquardt shift relative to each diagonal entry of H (SolverOptions::diagonal_shift) in the
-    // dry solves, opt-in: it pays on the seed scheme's very short segments (docs/solvers.md). The wet relaxation
-    // keeps mu I.
-    bool diagonal_shift = false;
 };
 
 // [wet] (docs/formats.md, "Wet scenes"; issue 6): capillary bridges for `fibernet wet`. Plain values here; the wet

@@ -33,14 +33,6 @@ struct LadderState {
     double dm = 1;       // mean |diag(H)|
     int pass = 0;
     SolveResult& result;
-    bool diagonal = false;  // SolverOptions::diagonal_shift: a shift s factors H + (s / dm) D, not H + s I
-
-    // The matrix a factoring rung's shift s gives: H + s I, or with `diagonal` H + (s / dm) D, D_jj = max(|H_jj|,
-    // 1e-8 dm) (Marquardt's scaling): each coordinate damped relative to its own stiffness, so that the stiff
-    // columns of very short segments (diagonals up to 1e6 x the mean on the seed scheme) do not set the damping of
-    // the soft ones, whose floppy modes a mean-scaled shift at its floor still held to linear convergence.
-    // factorize(`out`, `shift_out`) then factors that matrix.
-    const Eigen::SparseMatrix<double>& shifted(double s, double& shift_out);
 
     // g.d < -1e-12 |g| |d| with d finite.
     bool descent(const Eigen::VectorXd& d) const;
@@ -48,8 +40,6 @@ struct LadderState {
     bool factor_and_solve(LinearSolver& lin, double shift, Eigen::VectorXd& d);
     // Replaces H by the element-wise PSD-projected Hessian at q (once per iteration).
     void make_projected();
-
-    Eigen::SparseMatrix<double> scaled;  // shifted()'s work matrix (kept: its pattern is H's)
 };
 
 class NewtonRung {

@@ -25,8 +25,6 @@ struct SolverOptions {
     bool projected = false;  // Newton: projected Newton (newton_ladder.hpp): the element-wise PSD-projected H + mu I
                              // by LL^T while far from a minimum, the exact H + mu I (not shifted further) once a full
                              // step was accepted; excludes ldl. Others ignore it
-    bool diagonal_shift = false;  // Newton: the Levenberg-Marquardt shift relative to each diagonal entry (Marquardt's
-                                 // scaling, newton_ladder.hpp LadderState::shifted) instead of mu I; others ignore it
     bool eliminate = false;  // Newton: nonlinear elimination of the hot places before and inside each global step
                              // (nonlinear_elimination.hpp); others ignore it
     EliminationOptions elimination;
