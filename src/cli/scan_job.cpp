@@ -78,11 +78,16 @@ void check_job_args(const std::string& job, const std::vector<std::string>& args
     }
     CLI::App app;
     CLI::App* cmd = make_command(app, job);
-    cmd->callback([] {});  // parse only
+    // Parse only: stop after the options are parsed and checked, before the command's callback runs. The callback is
+    // kept, not replaced: it owns (through shared pointers) the variables the options write to, and replacing it
+    // freed them before the parse wrote into them.
+    struct Parsed {};
+    app.parse_complete_callback([] { throw Parsed{}; });
     std::vector<std::string> full = args;
     if (job == "sweep") full.insert(full.end(), {"-o", "sweep.csv"});  // the scan gives each sample's CSV
     try {
         parse(app, argv_of(cmd, job, "/dev/null", full));  // a stand-in scene that exists
+    } catch (const Parsed&) {
     } catch (const CLI::ParseError& e) {
         throw InputError("command line: --job-args for " + job + ": " + e.what());
     }

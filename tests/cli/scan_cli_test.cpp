@@ -225,7 +225,9 @@ TEST_CASE("cli scan: interrupting a wet or sweep sample ends the scan cleanly, a
     // and a sweep sample cut short must run again from the start on --resume (its unfinished checkpoint removed).
     const std::vector<std::pair<std::string, std::string>> jobs = {
         {"wet", "--L 2.2 --q 6 --pl 0.5 --vary seed=1:6 --job wet --job-args --no-moduli"},
-        {"sweep", "--L 3 --q 7 --scheme even --h 2.5 --vary seed=1:6 --job sweep --job-args \"--gamma-max 0.05 --step 0.01\""},
+        // Steps of 0.001: a sample lasts 0.3 s here, so the signal lands inside the scan, not after it.
+        {"sweep", "--L 3 --q 7 --scheme even --h 2.5 --vary seed=1:6 --job sweep --job-args \"--gamma-max 0.05 --step "
+                  "0.001 --max-step 0.001\""},
     };
     for (const auto& [job, args] : jobs) {
         INFO(job);
