@@ -165,6 +165,7 @@ Scene SceneFlags::resolve(bool complete) const {
 SolverOptions dry_solver_options(const Scene& s) {
     SolverOptions so;
     so.tol = s.solver.tol, so.max_iter = s.solver.max_iter, so.eliminate = s.solver.eliminate;
+    so.median_floor = true;  // docs/solvers.md "Newton's shift floor"
     return so;
 }
 

@@ -28,8 +28,26 @@ double mean_diag(const Eigen::SparseMatrix<double>& H) {
     return n > 0 ? s / n : 1.0;
 }
 
+// Median |diagonal|: the scale of the shift's floor. The floppy modes that need the smallest shift live on the soft
+// coordinates, which the median represents; the mean is set by the stiffest columns (very short segments: diagonals
+// up to 1e6 x the median on the seed scheme), and a floor at 1e-13 of it held those modes to a linear rate
+// (docs/solvers.md, "Newton's shift floor"). The same reason moved the moduli's shift to the median (docs/moduli.md).
+double median_diag(const Eigen::SparseMatrix<double>& H) {
+    const int n = static_cast<int>(H.cols());
+    std::vector<double> d;
+    d.reserve(n);
+    for (int j = 0; j < n; ++j) {
+        const int e = H.outerIndexPtr()[j + 1] - 1;
+        if (e >= H.outerIndexPtr()[j] && H.innerIndexPtr()[e] == j) d.push_back(std::abs(H.valuePtr()[e]));
+    }
+    if (d.empty()) return 1.0;
+    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+    return d[d.size() / 2];
+}
+
 constexpr double kArmijo = 1e-4;
-constexpr double kMuFloor = 1e-13;    // relative to mean diag: round-off scale of a null pivot
+constexpr double kMuFloor = 1e-13;    // relative to the median (SolverOptions::median_floor) or mean diag: round-off
+                                      // scale of a null pivot
 constexpr double kMuStart = 1e-8;     // relative to mean diag: first Levenberg-Marquardt shift
 constexpr int kMaxHalvings = 60;
 }  // namespace
@@ -87,7 +105,7 @@ public:
         const int n = f.size();
         H_ = f.hessian_pattern();
         g_.resize(n), gt_.resize(n), d_.resize(n), qt_.resize(n);
-        if (opt_.eliminate && n > 0) ne_ = std::make_unique<NonlinearElimination>(H_, opt_.elimination);
+        if (opt_.eliminate && n > 0) ne_ = std::make_unique<NonlinearElimination>(H_, opt_.elimination, opt_.median_floor);
         if (opt_.projected) start_rung_ = 1;
         return assemble(run, q, 0);
     }
@@ -195,7 +213,8 @@ private:
         const double dm = std::max(mean_diag(H_), std::numeric_limits<double>::min());
         if (mu_lm_ < 0) mu_lm_ = (opt_.warm_start && warm_shift_rel_ > 0 ? warm_shift_rel_ : kMuStart) * dm;
         dm_last_ = dm;
-        const double mu = std::max(kMuFloor * dm, mu_lm_);
+        mu_floor_ = kMuFloor * (opt_.median_floor ? median_diag(H_) : dm);
+        const double mu = std::max(mu_floor_, mu_lm_);
         LadderState ls{run.objective(), q, g_, H_, projected_, mu, dm, 0, r};
         int level = -1;
         double shift = 0, alpha = 1, ft = 0;
@@ -277,12 +296,12 @@ private:
         const double pred = -(alpha * g_.dot(d_) + 0.5 * alpha * alpha * d_.dot(Hd));
         const double actual = fq_ - ft;
         const double rho = pred > 1e-12 * (1 + std::abs(fq_)) ? actual / pred : 1.0;
-        if (alpha == 1 && rho > 0.5) mu_lm_ = std::max(kMuFloor * dm, shift / 10);
-        else if (alpha < 1 || rho < 0.25) mu_lm_ = std::max(4 * shift, kMuFloor * dm);
+        if (alpha == 1 && rho > 0.5) mu_lm_ = std::max(mu_floor_, shift / 10);
+        else if (alpha < 1 || rho < 0.25) mu_lm_ = std::max(4 * shift, mu_floor_);
         else mu_lm_ = shift;
         // After a retry the ladder's escalated shift damps the whole Hessian; the next LDL^T iteration grows from
         // its own shift instead, as after a backtracked step.
-        if (retried) mu_lm_ = std::max(4 * mu, kMuFloor * dm);
+        if (retried) mu_lm_ = std::max(4 * mu, mu_floor_);
     }
 
     const SolverOptions& opt_;
@@ -295,6 +314,7 @@ private:
     Eigen::VectorXd g_, gt_, d_, qt_;
     std::vector<double> energies_;
     double fq_ = 0, gmax_ = 0, floor_ = 0, local_tol_ = 0;
+    double mu_floor_ = 0; // the shift's floor, kMuFloor x median diag of this iteration's H
     double mu_lm_ = -1;   // Levenberg-Marquardt shift, adapted from the model agreement of each step
     double dm_last_ = 0;  // mean diag of the last iteration's H (the shift is kept relative to it)
     int start_rung_ = 0;

@@ -156,7 +156,10 @@ Model mikado_model(double L, double q, double pl, std::uint64_t seed, Scheme sch
 // gives a hinge stiffness ~ 1 / (lt0 l^2), so coordinates rounded to ulp(30) = 3.6e-15 leave forces of
 // ~1e-10 for l ~ 5e-3 and ~1e-5 for l ~ 1e-4 (docs/moduli.md, "Round-off floor"). The strict cases reach 1e-10;
 // the others must reach their floor, with Newton's stalled-at-floor test.
+// With the shift's floor at either scale: the mean or the median diagonal (SolverOptions::median_floor).
 TEST_CASE("newton: machine-precision equilibrium on sheared periodic networks, quadratic at the end", "[newton][network]") {
+    const bool median_floor = GENERATE(false, true);
+    CAPTURE(median_floor);
     const std::vector<NetCase> cases = {
         {3, 6, 1.0, 3, Scheme::Even, 7, true},    {3, 6, 1.0, 3, Scheme::Even, 8, true},
         {3, 6, 0.8, 1, Scheme::Even, 7, true},    {4, 6, 1.0, 3, Scheme::Even, 7, true},
@@ -170,6 +173,7 @@ TEST_CASE("newton: machine-precision equilibrium on sheared periodic networks, q
         Eigen::VectorXd q = e.affine_map(e.dofs(m.x), Eigen::Matrix2d::Identity(), F);
         SolverOptions opt;
         opt.max_iter = 300;
+        opt.median_floor = median_floor;
         NewtonSolver newton(opt);
         const SolveResult r = newton.minimize(obj, q);
         INFO("L " << c.L << " q " << c.q << " pl " << c.pl << " a " << c.a << " scheme " << to_string(c.scheme)

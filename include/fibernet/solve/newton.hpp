@@ -7,7 +7,9 @@
 //                              solve's with SolverOptions::warm_start), cut 10x after a full step the quadratic model
 //                              predicted well (so mu -> 0 and convergence is quadratic, also on singular H:
 //                              translations, floppy clusters), raised after backtracking; floored at
-//                              mu_floor = 1e-13 * mean diag(H) (round-off scale of a null pivot). If H + mu I does
+//                              mu_floor = 1e-13 * median diag(H) with SolverOptions::median_floor, else * mean diag
+//                              (round-off scale of a null pivot: the floppy modes live on the soft coordinates, which
+//                              the median represents; the mean is set by the stiffest columns). If H + mu I does
 //                              not factor, the shift on the exact H is raised 4x at a time up to 0.2 mean diag;
 //      With SolverOptions::ldl, rung 0 is first a simplicial LDL^T of H + mu I with its negative pivots replaced by
 //      their magnitudes (cholmod_ldl.hpp): negative curvature is handled where it occurs, with no shift for the rest

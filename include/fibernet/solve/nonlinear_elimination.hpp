@@ -43,8 +43,9 @@ struct EliminationCounts {
 
 class NonlinearElimination {
 public:
-    // pattern: the objective's Hessian pattern (upper triangle), from which the coupling graph is built once.
-    NonlinearElimination(const Eigen::SparseMatrix<double>& pattern, EliminationOptions opt);
+    // pattern: the objective's Hessian pattern (upper triangle), from which the coupling graph is built once;
+    // median_floor: the local solves' SolverOptions::median_floor (the global Newton's).
+    NonlinearElimination(const Eigen::SparseMatrix<double>& pattern, EliminationOptions opt, bool median_floor = false);
 
     // Picks the parts from the gradient g at the current state; false (no parts) when nothing is hot beyond the grown
     // set's size limit or max|g| is zero.
@@ -61,6 +62,7 @@ public:
 
 private:
     EliminationOptions opt_;
+    bool median_floor_;
     std::vector<int> adj_start_, adj_;  // symmetric coupling graph over the coordinates
     std::vector<std::vector<int>> parts_;
     int selected_ = 0;

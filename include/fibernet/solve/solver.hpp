@@ -25,6 +25,9 @@ struct SolverOptions {
     bool projected = false;  // Newton: projected Newton (newton_ladder.hpp): the element-wise PSD-projected H + mu I
                              // by LL^T while far from a minimum, the exact H + mu I (not shifted further) once a full
                              // step was accepted; excludes ldl. Others ignore it
+    bool median_floor = false;  // Newton: the shift's floor relative to the median diagonal of H instead of the mean
+                                // (newton.hpp); the dry commands set it, the wet relaxations keep the mean, with
+                                // which their studies were measured (docs/solvers.md "Newton's shift floor")
     bool eliminate = false;  // Newton: nonlinear elimination of the hot places before and inside each global step
                              // (nonlinear_elimination.hpp); others ignore it
     EliminationOptions elimination;
