@@ -32,10 +32,9 @@ double mean_diag(const Eigen::SparseMatrix<double>& H) {
 // coordinates, which the median represents; the mean is set by the stiffest columns (very short segments: diagonals
 // up to 1e6 x the median on the seed scheme), and a floor at 1e-13 of it held those modes to a linear rate
 // (docs/solvers.md, "Newton's shift floor"). The same reason moved the moduli's shift to the median (docs/moduli.md).
-double median_diag(const Eigen::SparseMatrix<double>& H) {
+double median_diag(const Eigen::SparseMatrix<double>& H, std::vector<double>& d) {  // d: work space
     const int n = static_cast<int>(H.cols());
-    std::vector<double> d;
-    d.reserve(n);
+    d.clear();
     for (int j = 0; j < n; ++j) {
         const int e = H.outerIndexPtr()[j + 1] - 1;
         if (e >= H.outerIndexPtr()[j] && H.innerIndexPtr()[e] == j) d.push_back(std::abs(H.valuePtr()[e]));
@@ -213,7 +212,7 @@ private:
         const double dm = std::max(mean_diag(H_), std::numeric_limits<double>::min());
         if (mu_lm_ < 0) mu_lm_ = (opt_.warm_start && warm_shift_rel_ > 0 ? warm_shift_rel_ : kMuStart) * dm;
         dm_last_ = dm;
-        mu_floor_ = kMuFloor * (opt_.median_floor ? median_diag(H_) : dm);
+        mu_floor_ = kMuFloor * (opt_.median_floor ? median_diag(H_, diag_) : dm);
         const double mu = std::max(mu_floor_, mu_lm_);
         LadderState ls{run.objective(), q, g_, H_, projected_, mu, dm, 0, r};
         int level = -1;
@@ -312,7 +311,7 @@ private:
     std::unique_ptr<NonlinearElimination> ne_;
     Eigen::SparseMatrix<double> H_;
     Eigen::VectorXd g_, gt_, d_, qt_;
-    std::vector<double> energies_;
+    std::vector<double> energies_, diag_;
     double fq_ = 0, gmax_ = 0, floor_ = 0, local_tol_ = 0;
     double mu_floor_ = 0; // the shift's floor, kMuFloor x median diag of this iteration's H
     double mu_lm_ = -1;   // Levenberg-Marquardt shift, adapted from the model agreement of each step
