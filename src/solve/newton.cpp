@@ -17,28 +17,29 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// Mean |diagonal| of an upper-triangular CSC matrix (the diagonal is the last entry of each column).
-double mean_diag(const Eigen::SparseMatrix<double>& H) {
-    const int n = static_cast<int>(H.cols());
-    double s = 0;
-    for (int j = 0; j < n; ++j) {
-        const int e = H.outerIndexPtr()[j + 1] - 1;
-        if (e >= H.outerIndexPtr()[j] && H.innerIndexPtr()[e] == j) s += std::abs(H.valuePtr()[e]);
-    }
-    return n > 0 ? s / n : 1.0;
-}
-
-// Median |diagonal|: the scale of the shift's floor. The floppy modes that need the smallest shift live on the soft
-// coordinates, which the median represents; the mean is set by the stiffest columns (very short segments: diagonals
-// up to 1e6 x the median on the seed scheme), and a floor at 1e-13 of it held those modes to a linear rate
-// (docs/solvers.md, "Newton's shift floor"). The same reason moved the moduli's shift to the median (docs/moduli.md).
-double median_diag(const Eigen::SparseMatrix<double>& H, std::vector<double>& d) {  // d: work space
-    const int n = static_cast<int>(H.cols());
+// |diagonal| of an upper-triangular CSC matrix (the diagonal is the last entry of each column; a column without one
+// contributes nothing), in column order, into d (kept by the caller across iterations).
+void abs_diagonal(const Eigen::SparseMatrix<double>& H, std::vector<double>& d) {
     d.clear();
-    for (int j = 0; j < n; ++j) {
+    for (int j = 0; j < H.cols(); ++j) {
         const int e = H.outerIndexPtr()[j + 1] - 1;
         if (e >= H.outerIndexPtr()[j] && H.innerIndexPtr()[e] == j) d.push_back(std::abs(H.valuePtr()[e]));
     }
+}
+
+// Their mean over all n columns: the Hessian's scale, to which the first shift and the escalations are relative.
+double mean_of(const std::vector<double>& d, int n) {
+    double s = 0;
+    for (double x : d) s += x;
+    return n > 0 ? s / n : 1.0;
+}
+
+// Their median (reorders d): the scale of the shift's floor with SolverOptions::median_floor. The floppy modes that
+// need the smallest shift live on the soft coordinates, which the median represents; the mean is set by the stiffest
+// columns (very short segments: diagonals up to 1e6 x the median on the seed scheme), and a floor at 1e-13 of it held
+// those modes to a linear rate (docs/solvers.md, "Newton's shift floor"). The same reason moved the moduli's shift to
+// the median (docs/moduli.md).
+double median_of(std::vector<double>& d) {
     if (d.empty()) return 1.0;
     std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
     return d[d.size() / 2];
@@ -209,10 +210,11 @@ private:
     // redoes the iteration with the shifted LL^T rungs. Then the shift update. False: no step was accepted.
     bool descend_and_search(SolverRun& run, Eigen::VectorXd& q, int it) {
         SolveResult& r = run.result();
-        const double dm = std::max(mean_diag(H_), std::numeric_limits<double>::min());
+        abs_diagonal(H_, diag_);
+        const double dm = std::max(mean_of(diag_, static_cast<int>(H_.cols())), std::numeric_limits<double>::min());
         if (mu_lm_ < 0) mu_lm_ = (opt_.warm_start && warm_shift_rel_ > 0 ? warm_shift_rel_ : kMuStart) * dm;
         dm_last_ = dm;
-        mu_floor_ = kMuFloor * (opt_.median_floor ? median_diag(H_, diag_) : dm);
+        mu_floor_ = kMuFloor * (opt_.median_floor ? median_of(diag_) : dm);
         const double mu = std::max(mu_floor_, mu_lm_);
         LadderState ls{run.objective(), q, g_, H_, projected_, mu, dm, 0, r};
         int level = -1;
