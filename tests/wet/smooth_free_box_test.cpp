@@ -161,7 +161,10 @@ TEST_CASE("smooth free box: capillary load moves the box to zero stress, its sti
     double E_capillary[2];
     for (int partners : {0, 1}) {
         INFO("bundle_partners " << partners);
-        const WetRunOptions o = options(0.05, true, 1e-4, partners);
+        // beta = 0.05 put the uncapped free box of one OpenBLAS kernel (SkylakeX) within a strain of 2e-4 of a fold
+        // of its branch (the uncapped model's minima depend on the path; docs/wet.md); at 0.03 the box lies on the same
+        // branch with every kernel tried (docs/reliability.md).
+        const WetRunOptions o = options(0.03, true, 1e-4, partners);
         const WetRun r = run_wet(net, m, Eigen::Matrix2d::Identity(), o);
         REQUIRE(r.wet.converged);
         E_capillary[partners] = r.wet.energy.capillary;
@@ -171,30 +174,36 @@ TEST_CASE("smooth free box: capillary load moves the box to zero stress, its sti
         CHECK(f.residual0 > 10 * o.free_box.tol);  // the fixed box was under real stress
         CHECK(!f.F.isApprox(f.F0, 1e-6));
         CHECK(f.energy.total() < r.wet.energy.total());  // the box gave way
-        const SmoothWetParams p = resolved(m, 0.05, partners);
+        const SmoothWetParams p = resolved(m, o.params.beta, partners);
         check_smooth_free_box(m, f, p, dp, o.free_box);
         // One response per converged trial (it rejects a saddle), one at the start and one for the stability check.
         CHECK(f.stiffness_solves >= f.iterations + 2);
         CHECK(f.stiffness_solves <= f.relaxations + 2);
-        // The stiffness d2E*/ds2 / A against the second difference of relaxed energies at s (1 +- h) (the relaxed
-        // response is exact; the difference's error is O(h^2) and its rounding E/h^2 1e-16). h = 1e-4 is small enough
-        // that the relaxations at s (1 +- h) stay on the branch of the free box (at 1e-3 they leave it here).
+        // The stiffness d2E*/ds2 / A against second differences of relaxed energies at s (1 +- h), extrapolated from h
+        // and 2h (Richardson: error O(h^4); the relaxed response is exact; rounding E/h^2 1e-16). Each relaxation
+        // starts from the affine map of the free box and takes steps of at most 1e-3: energy never rises and steps
+        // are short, so it stays on the free box's branch (with the skin's 0.5 it can leave it).
         REQUIRE(f.stiffness_eigenvalues.size() == 1);
         NetworkEnergy dry(m);
         auto solver = make_solver("newton", o.solver_options);
-        double E[3];
-        const double h = 1e-4;
-        for (int k = -1; k <= 1; ++k) {
-            const Eigen::Matrix2d Fk = (1 + k * h) * f.F;
-            Eigen::VectorXd qk = dry.affine_map(f.q, f.F, Fk);
-            E[k + 1] = relaxed_energy(dry, Fk, p, dp, qk, *solver, o.smooth_relax);
-        }
-        // d/ds along F = s F0 at s: dF = F0 ds, and (1 + t) F = (s + t s) F0, so d2E*/dt2 = s^2 d2E*/ds2.
+        SmoothRelaxOptions ro = o.smooth_relax;
+        ro.max_step = 1e-3;
         const double A = std::abs((f.F * m.box.B0()).determinant());
-        const double K_fd = (E[0] - 2 * E[1] + E[2]) / (h * h) / (f.s * f.s) / A;
+        auto second_difference = [&](double h) {
+            double E[3];
+            for (int k = -1; k <= 1; ++k) {
+                const Eigen::Matrix2d Fk = (1 + k * h) * f.F;
+                Eigen::VectorXd qk = dry.affine_map(f.q, f.F, Fk);
+                E[k + 1] = relaxed_energy(dry, Fk, p, dp, qk, *solver, ro);
+            }
+            // d/ds along F = s F0 at s: dF = F0 ds, and (1 + t) F = (s + t s) F0, so d2E*/dt2 = s^2 d2E*/ds2.
+            return (E[0] - 2 * E[1] + E[2]) / (h * h) / (f.s * f.s) / A;
+        };
+        const double h = 1e-4;
+        const double K_fd = (4 * second_difference(h) - second_difference(2 * h)) / 3;
         INFO("stiffness " << f.stiffness_eigenvalues[0] << ", second difference " << K_fd);
         CHECK(f.stiffness_eigenvalues[0] > 0);
-        CHECK(f.stiffness_eigenvalues[0] == Approx(K_fd).epsilon(1e-3));
+        CHECK(f.stiffness_eigenvalues[0] == Approx(K_fd).epsilon(1e-4));
     }
     CHECK(E_capillary[1] > E_capillary[0] + 0.05 * std::abs(E_capillary[0]));  // the cap binds on this network
 }
