@@ -68,21 +68,28 @@ using namespace fibernet;
 
 namespace {
 
-// A solver by registry name, or "newton+eliminate": Newton with nonlinear elimination (`--eliminate`), charted beside
-// plain Newton.
-const char* const kEliminate = "+eliminate";
+// A solver by registry name with optional suffixes: "+eliminate", nonlinear elimination (`--eliminate`);
+// "+median", the shift floor at the median diagonal (SolverOptions::median_floor). "newton+eliminate+median" is what
+// the dry commands run by default since 2026-12-04 (src/cli/common.cpp, dry_solver_options), charted beside plain
+// Newton.
 std::unique_ptr<Solver> bench_solver(const std::string& spec, SolverOptions opt) {
-    const size_t k = spec.size() > std::strlen(kEliminate) ? spec.size() - std::strlen(kEliminate) : 0;
-    if (k > 0 && spec.compare(k, std::string::npos, kEliminate) == 0) {
-        opt.eliminate = true;
-        return make_solver(spec.substr(0, k), opt);
+    std::string name = spec;
+    for (bool more = true; more;) {
+        more = false;
+        for (const char* suffix : {"+eliminate", "+median"}) {
+            const size_t n = std::strlen(suffix);
+            if (name.size() > n && name.compare(name.size() - n, n, suffix) == 0) {
+                (suffix[1] == 'e' ? opt.eliminate : opt.median_floor) = true;
+                name.resize(name.size() - n), more = true;
+            }
+        }
     }
-    return make_solver(spec, opt);
+    return make_solver(name, opt);
 }
-// Every registered solver, with newton+eliminate after newton.
+// Every registered solver, with newton+eliminate and the dry commands' default after newton.
 std::vector<std::string> bench_solver_names() {
     std::vector<std::string> names = solver_names();
-    names.insert(names.begin() + 1, std::string("newton") + kEliminate);
+    names.insert(names.begin() + 1, {"newton+eliminate", "newton+eliminate+median"});
     return names;
 }
 

@@ -9,7 +9,7 @@ import collections
 import csv
 import sys
 
-ORDER = ["newton", "newton+eliminate", "lbfgs-hessian", "ipopt", "lbfgs", "nlopt-lbfgs", "nlopt-var2",
+ORDER = ["newton", "newton+eliminate", "newton+eliminate+median", "lbfgs-hessian", "ipopt", "lbfgs", "nlopt-lbfgs", "nlopt-var2",
          "nlopt-tnewton", "cg", "fire"]
 COLS = [("converged", "ok"), ("iteration_limit", "budget"), ("line_search_failed", "LS-fail"), ("stalled", "stalled"),
         ("non_finite", "non-finite"), ("failed", "failed")]
