@@ -198,9 +198,14 @@ Checkpoint read_checkpoint(const std::string& path, const nlohmann::json& params
     if (!(is >> key >> s.t) || key != "t") fail("missing t");
     if (!(is >> key >> s.next_step) || key != "next_step") fail("missing next_step");
     if (!(is >> key) || key != "q") fail("missing q");
-    s.q.resize(c.dofs);
-    for (int i = 0; i < c.dofs; ++i)
-        if (!(is >> s.q[i]) || !std::isfinite(s.q[i])) fail("q[" + std::to_string(i) + "] is missing or not finite");
+    // Read value by value, not into a vector of the declared size: a corrupt count must not allocate it.
+    std::vector<double> q;
+    for (double v; static_cast<int>(q.size()) < c.dofs; q.push_back(v)) {
+        if (!(is >> v))
+            fail("dofs = " + std::to_string(c.dofs) + ", but only " + std::to_string(q.size()) + " values of q follow");
+        if (!std::isfinite(v)) fail("q[" + std::to_string(q.size()) + "] is not finite");
+    }
+    s.q = Eigen::Map<const Eigen::VectorXd>(q.data(), static_cast<Eigen::Index>(q.size()));
     if (is >> key) fail("unexpected '" + key + "' after the " + std::to_string(c.dofs) + " values of q");
     check_sweep_state(c, p, fail);
     return c;

@@ -1,5 +1,6 @@
 #include "fibernet/model/model_io.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <istream>
 #include <ostream>
@@ -50,6 +51,8 @@ void write_model(std::ostream& os, const Model& m, const Eigen::VectorXd& uin, c
 }
 
 namespace {
+// Entries reserved ahead of reading them: a file's count is believed only as far as its lines bear it out.
+constexpr long kReserveAtMost = 1 << 16;
 struct Reader {
     std::istream& is;
     std::string source;
@@ -142,30 +145,34 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* u
     m.aspect_ratio = r.keyed("aspect_ratio");
     m.fiber_length = r.keyed("fiber_length");
     r.keyed("softcore_eps_star");
+    // Entries are appended as they are read: a corrupt count must not allocate that many.
     const long n = r.section("nodes");
-    Eigen::VectorXd u(2 * n);
-    m.x.resize(2 * n);
-    m.fixed.assign(n, 0);
+    std::vector<double> x_ref, u_ref;
+    x_ref.reserve(2 * static_cast<size_t>(std::min(n, kReserveAtMost)));
+    u_ref.reserve(x_ref.capacity());
+    m.fixed.clear();
     for (long i = 0; i < n; ++i) {
         auto ss = r.next("node");
         const double x = r.num(ss, "node x"), y = r.num(ss, "node y");
-        m.fixed[i] = static_cast<char>(r.integer(ss, "node fixed flag", 0, 1));
-        m.x[2 * i] = r.num(ss, "node x_ref"), m.x[2 * i + 1] = r.num(ss, "node y_ref");
-        if (version == 1) {  // positions only: u as well as x can hold it
-            u[2 * i] = x - m.x[2 * i], u[2 * i + 1] = y - m.x[2 * i + 1];
-        } else {
-            u[2 * i] = r.num(ss, "node ux"), u[2 * i + 1] = r.num(ss, "node uy");
-        }
+        m.fixed.push_back(static_cast<char>(r.integer(ss, "node fixed flag", 0, 1)));
+        const double xr = r.num(ss, "node x_ref"), yr = r.num(ss, "node y_ref");
+        double ux = x - xr, uy = y - yr;  // version 1: positions only; u as well as x can hold it
+        if (version != 1) ux = r.num(ss, "node ux"), uy = r.num(ss, "node uy");
         // A node a thousand boxes away is no state of this network (and its energy overflows).
         const double reach = 1e3 * (std::abs(m.box.L) + std::abs(m.fiber_length));
-        for (double v : {m.x[2 * i], m.x[2 * i + 1], u[2 * i], u[2 * i + 1]})
+        for (double v : {xr, yr, ux, uy})
             if (!(std::abs(v) <= reach))
                 r.fail("node " + std::to_string(i) + ": coordinate " + show(v) + " lies beyond 1000 box sides (" +
                        show(reach) + ")");
+        x_ref.insert(x_ref.end(), {xr, yr}), u_ref.insert(u_ref.end(), {ux, uy});
     }
+    m.x = Eigen::Map<const Eigen::VectorXd>(x_ref.data(), static_cast<Eigen::Index>(x_ref.size()));
+    const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(u_ref.data(), static_cast<Eigen::Index>(u_ref.size()));
     const long ns = r.section("segments");
-    m.segments.resize(ns);
-    for (auto& s : m.segments) {
+    m.segments.clear();
+    m.segments.reserve(static_cast<size_t>(std::min(ns, kReserveAtMost)));
+    for (long e = 0; e < ns; ++e) {
+        Segment& s = m.segments.emplace_back();
         auto ss = r.next("segment");
         s.i = r.integer(ss, "segment node i", 0, n - 1), s.j = r.integer(ss, "segment node j", 0, n - 1);
         s.shift.x() = r.integer(ss, "segment shift x", -1000000, 1000000);
@@ -179,8 +186,10 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* u
         }
     }
     const long nh = r.section("hinges");
-    m.hinges.resize(nh);
-    for (auto& h : m.hinges) {
+    m.hinges.clear();
+    m.hinges.reserve(static_cast<size_t>(std::min(nh, kReserveAtMost)));
+    for (long e = 0; e < nh; ++e) {
+        Hinge& h = m.hinges.emplace_back();
         auto ss = r.next("hinge");
         h.i = r.integer(ss, "hinge node i", 0, n - 1), h.j = r.integer(ss, "hinge node j", 0, n - 1),
         h.k = r.integer(ss, "hinge node k", 0, n - 1);
@@ -198,8 +207,10 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* u
         }
     }
     const long nsn = r.section("supernodes");
-    m.supernodes.resize(nsn);
-    for (auto& s : m.supernodes) {
+    m.supernodes.clear();
+    m.supernodes.reserve(static_cast<size_t>(std::min(nsn, kReserveAtMost)));
+    for (long e = 0; e < nsn; ++e) {
+        Supernode& s = m.supernodes.emplace_back();
         auto ss = r.next("supernode");
         s.node = r.integer(ss, "supernode node", 0, n - 1);
         const long k = r.integer(ss, "supernode crossing count", 0, 1000);

@@ -41,6 +41,8 @@ void write_network(std::ostream& os, const Network& net) {
 }
 
 namespace {
+// Entries reserved ahead of reading them: a file's count is believed only as far as its lines bear it out.
+constexpr long kReserveAtMost = 1 << 16;
 struct LineReader {
     std::istream& is;
     std::string source;
@@ -134,10 +136,12 @@ Network read_network(std::istream& is, const std::string& source) {
     if (kw != "fibers") r.fail("expected 'fibers N', found '" + r.text + "'");
     const long nf = r.integer(ss, "fiber count", 0, 100000000);
     r.expect_end(ss);
-    net.fibers.resize(nf);
+    // Entries are appended as they are read: a corrupt count must not allocate that many (kReserveAtMost).
+    net.fibers.clear();
+    net.fibers.reserve(static_cast<size_t>(std::min(nf, kReserveAtMost)));
     for (long i = 0; i < nf; ++i) {
         auto ls = r.next("fiber " + std::to_string(i));
-        Fiber& f = net.fibers[i];
+        Fiber& f = net.fibers.emplace_back();
         f.start.x() = r.number(ls, "fiber x0");
         f.start.y() = r.number(ls, "fiber y0");
         f.theta = r.number(ls, "fiber theta");
@@ -152,14 +156,15 @@ Network read_network(std::istream& is, const std::string& source) {
         r.keyword(cs, "crossings");
         const long nc = r.integer(cs, "crossing count", 0, 1000000000);
         r.expect_end(cs);
-        net.crossings.resize(nc);
+        net.crossings.clear();
+        net.crossings.reserve(static_cast<size_t>(std::min(nc, kReserveAtMost)));
         // Two straight fibers cross at most once per periodic image: a repeated line would count twice. Found by
         // sorting (fiber pair, image, line) keys after reading (a map node per crossing cost ~200 MB at 2.5e6).
         std::vector<std::pair<std::array<int, 4>, std::array<long, 2>>> keys;  // key, (crossing, line)
-        keys.reserve(static_cast<size_t>(nc));
+        keys.reserve(static_cast<size_t>(std::min(nc, kReserveAtMost)));
         for (long k = 0; k < nc; ++k) {
             auto ls = r.next("crossing " + std::to_string(k));
-            Crossing& c = net.crossings[k];
+            Crossing& c = net.crossings.emplace_back();
             c.f1 = static_cast<int>(r.integer(ls, "crossing f1", 0, nf - 1));
             c.f2 = static_cast<int>(r.integer(ls, "crossing f2", 0, nf - 1));
             if (c.f1 == c.f2) r.fail("crossing joins fiber " + std::to_string(c.f1) + " to itself");

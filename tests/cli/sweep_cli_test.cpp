@@ -78,6 +78,17 @@ TEST_CASE("cli sweep: --resume refuses a checkpoint of other parameters, naming 
                          "next_step 0.01\nq\n");
     CHECK(run(net + "--seed 4 --a 10 --resume -o " + csv) == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("version 1 does not record") != std::string::npos);
+    // A corrupt count of q's values is refused by name, not allocated (fuzzing: dofs 1000000000 ended in
+    // std::bad_alloc, exit 3).
+    std::string big = ckpt;
+    const size_t at = big.find("\ndofs ");
+    REQUIRE(at != std::string::npos);
+    const std::string dofs = big.substr(at + 6, big.find('\n', at + 1) - at - 6);
+    big.replace(at + 6, dofs.size(), "1000000000");
+    write(csv + ".ckpt", big);
+    CHECK(run(net + "--seed 4 --a 10 --resume -o " + csv) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("dofs = 1000000000, but only " + dofs + " values of q follow") !=
+          std::string::npos);
 }
 
 TEST_CASE("cli sweep: an unfinished sweep's checkpoint needs --resume; a completed sweep or a CSV alone is replaced",

@@ -8,6 +8,7 @@
 #include "fibernet/model/model_io.hpp"
 #include "fibernet/network/mikado.hpp"
 #include "fibernet/solve/newton.hpp"
+#include "fibernet/util/error.hpp"
 
 using namespace fibernet;
 
@@ -48,4 +49,32 @@ TEST_CASE("model file: a relaxed sheared state re-evaluates at its reported max|
     // segments here), and the state from x_ref + u by more.
     REQUIRE(summarize(r).shortest_segment < 0.05);  // the regime where it matters
     CHECK(max_grad(e2, q2, F2) <= eq.result.grad_max + 1e-12);
+}
+
+TEST_CASE("model file: a section count beyond the lines that follow is refused, not allocated", "[model][io][input]") {
+    // Fuzzing found "nodes 1999999999" ending in std::bad_alloc (exit 3): entries are now appended as they are read.
+    MikadoParams mp;
+    mp.L = 2.5, mp.q = 4, mp.pl = 1, mp.seed = 1;
+    const Model m = discretize(generate_mikado(mp), DiscretizationParams{});
+    std::stringstream file;
+    write_model(file, m);
+    const std::string text = file.str();
+    {
+        std::istringstream is(text);
+        CHECK(read_model(is, "m.txt").segments.size() == m.segments.size());
+    }
+    for (const char* section : {"nodes", "segments", "hinges", "supernodes"}) {
+        const std::string key = std::string("\n") + section + " ";
+        const size_t at = text.find(key);
+        REQUIRE(at != std::string::npos);
+        const size_t end = text.find('\n', at + 1);
+        std::istringstream is(text.substr(0, at) + key + "1999999999" + text.substr(end));
+        INFO(section);
+        try {
+            read_model(is, "m.txt");
+            FAIL("accepted");
+        } catch (const InputError& e) {
+            CHECK(std::string(e.what()).find("m.txt:") != std::string::npos);
+        }
+    }
 }

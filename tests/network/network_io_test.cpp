@@ -74,5 +74,9 @@ TEST_CASE("network io: malformed files are rejected with file, line and value", 
                               "0 2 0.2 0.5 0 0 1\n0 1 0.5 0.5 0 0 1\n";
     expect_error(replace(replace(three, "1 2 0.5 0.5 0 0 1\n", "0 1 0.5 0.5 0 0 1\n"), "crossings 4\n", "crossings 4\n"),
                  "net.txt:10: crossing 2 repeats crossing 1 (fibers 0 and 2)");
+    // A count far beyond the lines that follow is refused at the file's end, not trusted to allocate (fuzzing:
+    // "crossings 900000000" ended in std::bad_alloc, exit 3).
+    expect_error(replace(valid(), "crossings 1\n", "crossings 900000000\n"), "unexpected end of file, expected crossing 1");
+    expect_error(replace(valid(), "fibers 2\n", "fibers 99999999\n"), "fiber x0 = 'crossings' is not a number");
     CHECK_THROWS_AS(load_network("/nonexistent/file.txt"), InputError);
 }
