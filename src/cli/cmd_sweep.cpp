@@ -240,6 +240,12 @@ std::vector<std::pair<int, double>> truncate_csv(const std::string& path, int ro
         for (size_t k = 1; k < f.size(); ++k)  // every value the sweep writes is a finite number
             if (!parse_decimal(f[k], k == 1 ? gamma : v))
                 fail(row + " field " + std::to_string(k + 1) + " is '" + f[k] + "', not a number the sweep writes");
+        // The strains run from 0 (step 0) toward t, each beyond the last and short of t but the last row's, which is t
+        // (below): a damaged row in the middle is refused.
+        const double last = steps.empty() ? 0 : steps.back().second;
+        const bool in_order = n == 0 ? gamma == 0 : t > 0 ? gamma > last && gamma < t : gamma < last && gamma > t;
+        if (n + 1 < rows && !in_order)
+            fail(row + " has gamma '" + f[1] + "', out of the sweep's order from 0 to the checkpoint's t = " + show(t));
         if (n + 1 == rows && gamma != t)  // 17 digits: the value round-trips exactly
             fail("row " + std::to_string(rows) + " has gamma '" + f[1] + "', the checkpoint's t = " + show(t));
         kept += line + "\n";

@@ -165,7 +165,8 @@ TEST_CASE("cli sweep: --resume refuses checkpoint fields and CSV rows no sweep w
         {with("rows", "2"), "step = 2 must be rows - 1 = 1"},
         {with("t", "-617"), "t = -617 is not a strain this sweep reaches"},
         {with("t", "0.03"), "t = 0.029999999999999999 is not a strain"},
-        {with("t", "0.01"), "row 3 has gamma '0.02', the checkpoint's t = 0.01"},
+        {with("t", "0.01"), "row 2 has gamma '0.01', out of the sweep's order from 0 to the checkpoint's t = 0.01"},
+        {with("t", "0.015"), "row 3 has gamma '0.02', the checkpoint's t = 0.014999999999999999"},
         {with("t", "0.01").replace(ckpt.find("\ncompleted 0\n"), 13, "\ncompleted 1\n"),
          "completed = 1 contradicts t = 0.01"},
         {ckpt + "7\n", "unexpected '7' after the"},
@@ -200,6 +201,18 @@ TEST_CASE("cli sweep: --resume refuses checkpoint fields and CSV rows no sweep w
         CHECK(run(net + csv + " --resume") == 2);
         CHECK(slurp(tmpdir() + "/stderr").find("row 2 field 3 is '" + value + "', not a number the sweep writes") !=
               std::string::npos);
+    }
+    // A damaged strain in the middle (fuzzing: gamma = 3.0 in row 2 of a sweep to 0.02 was kept).
+    for (const std::string gamma : {"3.0", "0.02", "0", "-0.01"}) {
+        INFO("row 2 gamma = " << gamma);
+        bad = rows;
+        const auto at = bad.find("\n1,") + 3;
+        bad.replace(at, bad.find(',', at) - at, gamma);
+        write(csv, bad);
+        CHECK(run(net + csv + " --resume") == 2);
+        CHECK(slurp(tmpdir() + "/stderr").find("row 2 has gamma '" + gamma + "', out of the sweep's order") !=
+              std::string::npos);
+        CHECK(slurp(csv) == bad);
     }
     bad = rows;
     bad.replace(bad.find("\n1,") + 1, 2, "1,2,");
