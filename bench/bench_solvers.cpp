@@ -73,17 +73,19 @@ namespace {
 // the dry commands run by default since 2026-12-04 (src/cli/common.cpp, dry_solver_options), charted beside plain
 // Newton.
 std::unique_ptr<Solver> bench_solver(const std::string& spec, SolverOptions opt) {
+    static const std::pair<std::string, bool SolverOptions::*> suffixes[] = {{"+eliminate", &SolverOptions::eliminate},
+                                                                             {"+median", &SolverOptions::median_floor}};
     std::string name = spec;
     for (bool more = true; more;) {
         more = false;
-        for (const char* suffix : {"+eliminate", "+median"}) {
-            const size_t n = std::strlen(suffix);
-            if (name.size() > n && name.compare(name.size() - n, n, suffix) == 0) {
-                (suffix[1] == 'e' ? opt.eliminate : opt.median_floor) = true;
-                name.resize(name.size() - n), more = true;
+        for (const auto& [suffix, flag] : suffixes)
+            if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+                if (opt.*flag) throw std::invalid_argument("bench_solvers: '" + spec + "' repeats " + suffix);
+                opt.*flag = true, name.resize(name.size() - suffix.size()), more = true;
             }
-        }
     }
+    if (name != spec && name != "newton")
+        throw std::invalid_argument("bench_solvers: '" + spec + "': only newton takes +eliminate and +median");
     return make_solver(name, opt);
 }
 // Every registered solver, with newton+eliminate and the dry commands' default after newton.

@@ -201,9 +201,11 @@ Checkpoint read_checkpoint(const std::string& path, const nlohmann::json& params
     // Read value by value, not into a vector of the declared size: a corrupt count must not allocate it.
     std::vector<double> q;
     for (double v; static_cast<int>(q.size()) < c.dofs; q.push_back(v)) {
-        if (!(is >> v))
+        std::string token;
+        if (!(is >> token))
             fail("dofs = " + std::to_string(c.dofs) + ", but only " + std::to_string(q.size()) + " values of q follow");
-        if (!std::isfinite(v)) fail("q[" + std::to_string(q.size()) + "] is not finite");
+        if (!parse_decimal(token, v))
+            fail("q[" + std::to_string(q.size()) + "] = '" + token + "' is not a finite number");
     }
     s.q = Eigen::Map<const Eigen::VectorXd>(q.data(), static_cast<Eigen::Index>(q.size()));
     if (is >> key) fail("unexpected '" + key + "' after the " + std::to_string(c.dofs) + " values of q");

@@ -170,6 +170,12 @@ TEST_CASE("cli sweep: --resume refuses checkpoint fields and CSV rows no sweep w
         {with("t", "0.01").replace(ckpt.find("\ncompleted 0\n"), 13, "\ncompleted 1\n"),
          "completed = 1 contradicts t = 0.01"},
         {ckpt + "7\n", "unexpected '7' after the"},
+        {[&] {
+             std::string ck = ckpt;
+             const auto at = ck.find("\nq\n") + 3;
+             return ck.replace(at, ck.find('\n', at) - at, "nan");
+         }(),
+         "q[0] = 'nan' is not a finite number"},
     };
     for (const auto& c : cases) {
         INFO(c.message);

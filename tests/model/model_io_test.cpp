@@ -63,7 +63,12 @@ TEST_CASE("model file: a section count beyond the lines that follow is refused, 
         std::istringstream is(text);
         CHECK(read_model(is, "m.txt").segments.size() == m.segments.size());
     }
-    for (const char* section : {"nodes", "segments", "hinges", "supernodes"}) {
+    // What each reads instead of the entries it was promised: the next section's line, or the file's end.
+    const std::pair<const char*, const char*> sections[] = {{"nodes", "node x = 'segments'"},
+                                                            {"segments", "segment node i = 'hinges'"},
+                                                            {"hinges", "hinge node i = 'supernodes'"},
+                                                            {"supernodes", "unexpected end of file, expected supernode"}};
+    for (const auto& [section, message] : sections) {
         const std::string key = std::string("\n") + section + " ";
         const size_t at = text.find(key);
         REQUIRE(at != std::string::npos);
@@ -74,7 +79,9 @@ TEST_CASE("model file: a section count beyond the lines that follow is refused, 
             read_model(is, "m.txt");
             FAIL("accepted");
         } catch (const InputError& e) {
+            INFO(e.what());
             CHECK(std::string(e.what()).find("m.txt:") != std::string::npos);
+            CHECK(std::string(e.what()).find(message) != std::string::npos);
         }
     }
 }

@@ -10,8 +10,9 @@ native=$(OPENBLAS_VERBOSE=2 "$exe" --version 2>&1 | sed -n 's/^Core: //p' | head
 flags=$(grep -m1 '^flags' /proc/cpuinfo || true)
 # Kernels this CPU can run, widest first; the first that is not the native one.
 candidates=()
-[[ $flags == *" avx512f"* && $flags == *" avx512bw"* && $flags == *" avx512vl"* && $flags == *" avx512dq"* ]] &&
-  candidates+=(SkylakeX)
+# SkylakeX's double-precision kernels are those of Cooperlake and SapphireRapids: no other rounding there.
+[[ $flags == *" avx512f"* && $flags == *" avx512bw"* && $flags == *" avx512vl"* && $flags == *" avx512dq"* &&
+   $native != Cooperlake && $native != SapphireRapids ]] && candidates+=(SkylakeX)
 [[ $flags == *" avx2"* ]] && candidates+=(Haswell)
 [[ $flags == *" avx "* ]] && candidates+=(SandyBridge)
 [[ $flags == *" sse4_2"* ]] && candidates+=(Nehalem)
