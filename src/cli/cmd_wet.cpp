@@ -286,6 +286,7 @@ void register_wet(CLI::App& app) {
         opt.solver = s.solver.name;
         opt.solver_options.tol = s.solver.tol, opt.solver_options.max_iter = s.solver.max_iter;
         opt.solver_options.eliminate = s.wet.newton_eliminate;
+        if (s.wet.model == "smooth") opt.solver_options.elimination.hops = s.wet.eliminate_hops;
         opt.solver_options.verbose = w->verbose;
         opt.active_set.verbose = w->verbose || !w->quiet;
         opt.active_set.max_rounds = s.wet.max_rounds;
@@ -400,7 +401,10 @@ void register_wet(CLI::App& app) {
                                 {"strain", to_string(s.strain)},
                                 {"gamma", s.gamma},
                                 {"solver", {{"name", s.solver.name}, {"tol", s.solver.tol}, {"max_iter", s.solver.max_iter},
-                                            {"eliminate", s.wet.newton_eliminate}}},
+                                            {"eliminate", s.wet.newton_eliminate},
+                                            {"eliminate_hops", s.wet.newton_eliminate && s.wet.model == "smooth"
+                                                                   ? nlohmann::json(s.wet.eliminate_hops)
+                                                                   : nlohmann::json()}}},
                                 {"runs", runs},
                                 {"complete", complete},
                                 {"seconds", seconds_since(t_all)}};
@@ -574,6 +578,8 @@ void register_wet(CLI::App& app) {
                                                                           {"pattern_builds", r.smooth.pattern_builds},
                                                                           {"stale_patterns", r.smooth.stale_patterns},
                                                                           {"factorizations", r.smooth.factorizations},
+                                                                          {"local_solves", r.smooth.local_solves},
+                                                                          {"local_iterations", r.smooth.local_iterations},
                                                                           {"seconds_patterns", r.smooth.seconds_patterns},
                                                                           {"seconds_solver",
                                                                            {{"assembly", r.smooth.timings.assembly},

@@ -71,6 +71,7 @@ void Scene::check_values() const {
                 "must lie in [0, 1]");
     check_value(wet.local_threshold > 0 && wet.local_threshold < 1, wet.local_threshold, source, "[wet].local_threshold",
                 "must lie in (0, 1)");
+    check_value(wet.eliminate_hops >= 0, wet.eliminate_hops, source, "[wet].eliminate_hops", "must be >= 0");
     check_value(wet.local_hops >= 0, wet.local_hops, source, "[wet].local_hops", "must be >= 0");
     check_value(wet.bundle_partners >= 0, wet.bundle_partners, source, "[wet].bundle_partners", "must be >= 0 (0: no cap)");
     if (wet.model != "events" && wet.model != "smooth")

@@ -138,6 +138,10 @@ std::vector<SceneOption> declare() {
     add(boolean("wet", "newton_eliminate", "--wet-eliminate",
                 "Newton's nonlinear elimination in the wet relaxation (off by default: docs/solvers.md)",
                 [](Scene& s) -> bool& { return s.wet.newton_eliminate; }));
+    add(integer("wet", "eliminate_hops", "--wet-eliminate-hops",
+                "smooth model with --wet-eliminate: coordinate hops the hot set grows by before its local solves "
+                "(the event model keeps the dry default, 16; docs/wet.md)",
+                [](Scene& s) -> int& { return s.wet.eliminate_hops; }));
     add(real("wet", "local_fraction", "", "local rounds: largest part of the coordinates",
              [](Scene& s) -> double& { return s.wet.local_fraction; }));
     add(real("wet", "local_threshold", "", "local rounds: hot where |g| > threshold x max|g|",

@@ -105,7 +105,7 @@ public:
         const int n = f.size();
         H_ = f.hessian_pattern();
         g_.resize(n), gt_.resize(n), d_.resize(n), qt_.resize(n);
-        if (opt_.eliminate && n > 0) ne_ = std::make_unique<NonlinearElimination>(H_, opt_.elimination, opt_.median_floor);
+        if (opt_.eliminate && n > 0) ne_ = std::make_unique<NonlinearElimination>(H_, opt_.elimination, opt_.median_floor, opt_.max_step);
         if (opt_.projected) start_rung_ = 1;
         return assemble(run, q, 0);
     }

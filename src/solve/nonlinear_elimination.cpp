@@ -19,8 +19,9 @@ void EliminationOptions::check(const std::string& where) const {
     check_value(local_max_iter >= 1, local_max_iter, where, "elimination.local_max_iter", "must be >= 1");
 }
 
-NonlinearElimination::NonlinearElimination(const Eigen::SparseMatrix<double>& P, EliminationOptions opt, bool median_floor)
-    : opt_(opt), median_floor_(median_floor) {
+NonlinearElimination::NonlinearElimination(const Eigen::SparseMatrix<double>& P, EliminationOptions opt, bool median_floor,
+                                           double max_step)
+    : opt_(opt), median_floor_(median_floor), max_step_(max_step) {
     opt_.check("newton");
     const int n = static_cast<int>(P.cols());
     // Both triangles of the pattern, without the diagonal: coordinate i couples j when some element holds both.
@@ -82,7 +83,7 @@ bool NonlinearElimination::select(const Eigen::VectorXd& g) {
 void NonlinearElimination::eliminate(Objective& f, Eigen::VectorXd& q, double tol, double max_seconds) {
     const auto t0 = std::chrono::steady_clock::now();
     SolverOptions o;
-    o.tol = tol, o.max_iter = opt_.local_max_iter, o.median_floor = median_floor_;
+    o.tol = tol, o.max_iter = opt_.local_max_iter, o.median_floor = median_floor_, o.max_step = max_step_;
     for (const std::vector<int>& part : parts_) {
         if (max_seconds > 0) {
             const double left = max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

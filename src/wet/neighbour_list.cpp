@@ -210,6 +210,16 @@ bool NeighbourList::valid(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) co
     return true;
 }
 
+bool NeighbourList::valid_at(const std::vector<int>& nodes, const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const {
+    if (builds_ == 0 || B != B_built_ || x.size() != x_built_.size()) return false;
+    const double h2 = 0.25 * built_skin_ * built_skin_;
+    for (int v : nodes) {
+        const double dx = x[2 * v] - x_built_[2 * v], dy = x[2 * v + 1] - x_built_[2 * v + 1];
+        if (dx * dx + dy * dy > h2) return false;
+    }
+    return true;
+}
+
 double NeighbourList::max_displacement(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const {
     if (builds_ == 0 || B != B_built_ || x.size() != x_built_.size()) return std::numeric_limits<double>::infinity();
     double m2 = 0;

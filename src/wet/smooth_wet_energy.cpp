@@ -8,6 +8,7 @@
 #include "fibernet/energy/sparse_pattern.hpp"
 #include "fibernet/util/parallel.hpp"
 #include "fibernet/wet/bundle_saturation.hpp"
+#include "fibernet/wet/smooth_wet_region.hpp"
 
 namespace fibernet {
 
@@ -272,6 +273,7 @@ SmoothWetEnergy::PartnerCap SmoothWetEnergy::partner_cap(const Eigen::VectorXd& 
     }
     pc.scale.resize(n), pc.touching.resize(n);
     for (size_t i = 0; i < n; ++i) pc.scale[i] = 0.5 * (dS[P[on[i]].a] + dS[P[on[i]].b]), pc.touching[i] = Ec[i] != 0;
+    pc.pair_crossing.swap(Ex), pc.pair_contact.swap(Ec);
     return pc;
 }
 
@@ -360,6 +362,28 @@ void SmoothWetEnergy::add_partner_blocks(const std::vector<char>& take, const Ei
                 idx.insert(idx.end(), ov, ov + 4);
             }
     }
+}
+
+void SmoothWetEnergy::index_segment_pairs() const {
+    if (seg_pair_list_ == list_.builds()) return;
+    const std::vector<SegmentPair>& P = list_.pairs();
+    const size_t ns = dry_.model().segments.size();
+    seg_pair_start_.assign(ns + 1, 0);
+    for (const SegmentPair& p : P) ++seg_pair_start_[p.a + 1], ++seg_pair_start_[p.b + 1];
+    for (size_t s = 0; s < ns; ++s) seg_pair_start_[s + 1] += seg_pair_start_[s];
+    seg_pair_.resize(seg_pair_start_[ns]);
+    std::vector<int> fill(seg_pair_start_.begin(), seg_pair_start_.end() - 1);
+    for (size_t k = 0; k < P.size(); ++k) {
+        seg_pair_[fill[P[k].a]++] = static_cast<int>(k);
+        seg_pair_[fill[P[k].b]++] = static_cast<int>(k);
+    }
+    seg_pair_list_ = list_.builds();
+}
+
+std::unique_ptr<Objective> SmoothWetEnergy::restriction(const Eigen::VectorXd& q, const std::vector<int>& coords) {
+    if (!incidence_) incidence_ = std::make_shared<const NodeElements>(node_elements(dry_));
+    if (!active()) return std::make_unique<NetworkRegion>(dry_, F_, *incidence_, q, coords);
+    return std::make_unique<SmoothWetRegion>(*this, *incidence_, q, coords);
 }
 
 double SmoothWetEnergy::value(const Eigen::VectorXd& q) { return eval(q, nullptr, nullptr, false); }

@@ -39,6 +39,7 @@ SmoothRelaxResult relax_smooth_wet(SmoothWetEnergy& W, Solver& solver, Eigen::Ve
         R.last = solver.minimize(W, q);
         R.iterations += R.last.iterations, R.factorizations += R.last.factorizations;
         R.evaluations += R.last.evaluations;
+        R.local_solves += R.last.local_solves, R.local_iterations += R.last.local_iterations;
         R.timings += R.last.timings;
         R.energy = R.last.energy, R.grad_max = R.last.grad_max;
         const bool stale = W.pattern_stale();

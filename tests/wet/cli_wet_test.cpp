@@ -309,7 +309,8 @@ TEST_CASE("cli wet: summary.json records what reproduces the run", "[wet][cli]")
     CHECK(w["law_table"] == law_text);  // the table itself: the file may change or be gone
     CHECK(w["law_fnv1a"].is_number_unsigned());
     CHECK(w["moduli"] == false);
-    CHECK(j["solver"] == nlohmann::json({{"name", "newton"}, {"tol", 1e-10}, {"max_iter", 500}, {"eliminate", true}}));
+    CHECK(j["solver"] == nlohmann::json({{"name", "newton"}, {"tol", 1e-10}, {"max_iter", 500}, {"eliminate", true},
+                                         {"eliminate_hops", nullptr}}));  // the event model keeps the solver's hops
     CHECK(j["prune"] == nlohmann::json::array());
     CHECK(j["parameters"]["seed"] == 3);
     // The default law is named, with no table.
@@ -406,6 +407,22 @@ TEST_CASE("cli wet: the smooth model relaxes to an equilibrium of the whole ener
     CHECK(std::abs(G - Gfd) <= 1e-3 * G);
 }
 
+TEST_CASE("cli wet: the smooth model with nonlinear elimination reaches an equilibrium of the whole energy",
+          "[wet][cli][smooth]") {
+    const std::string out = tmpdir() + "/smooth_eliminate";
+    REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
+    REQUIRE(run("--L 2.5 --q 8 --pl 0.5 --seed 3 --beta 0.1 --wet-model smooth --bundle-partners 2 --wet-eliminate "
+                "--no-moduli --tol 1e-9 -q -o " + out) == 0);
+    const nlohmann::json j = read_json(out + "/summary.json");
+    CHECK(j["solver"]["eliminate"] == true);
+    CHECK(j["solver"]["eliminate_hops"] == 2);
+    const nlohmann::json& r = j["runs"][0];
+    CHECK(r["status"] == "stable");
+    CHECK(r["smooth"]["grad_max"].get<double>() <= 1e-9);
+    CHECK(r["smooth"]["local_solves"].get<int>() > 0);
+    CHECK(r["energy"]["wet"]["capillary"].get<double>() < 0);
+}
+
 TEST_CASE("cli wet: the smooth model with projected Newton and a partner cap", "[wet][cli][smooth]") {
     // A cap of 1 binds at beta = 0.1 on this network (the capillary energy is above the uncapped one), and the exact
     // linear modulus, whose strain derivatives carry the cap's coupling, matches the second difference.
@@ -444,5 +461,8 @@ TEST_CASE("cli wet: the smooth model's options are refused by name", "[wet][cli]
     CHECK(slurp(tmpdir() + "/stderr").find("[wet].crossing_width") != std::string::npos);
     CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --bundle-partners -2 -q -o " + out) == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("[wet].bundle_partners = -2") != std::string::npos);
+    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --wet-eliminate --wet-eliminate-hops -1 "
+              "-q -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("[wet].eliminate_hops = -1") != std::string::npos);
     CHECK(!exists(out));
 }

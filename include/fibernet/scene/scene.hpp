@@ -41,6 +41,9 @@ struct WetSettings {
     // Newton's nonlinear elimination in the wet relaxation: off, since on a landscape with many minima (zipping) it
     // commits the hot places to their nearest valley and gains nothing on the event model (docs/solvers.md).
     bool newton_eliminate = false;
+    // The smooth model's elimination: hops the hot set grows by (EliminationOptions::hops; the dry default of 16 grows
+    // a wet hot set past the quarter of the coordinates where elimination stands aside).
+    int eliminate_hops = 2;
     // Local rounds (docs/wet.md, "Local rounds"): the part of the network that needs a solve, if it holds at most
     // local_fraction of the coordinates (0: every round global); hot: |g| > local_threshold x max|g|, grown by local_hops.
     double local_fraction = 0.25;

@@ -44,8 +44,10 @@ struct EliminationCounts {
 class NonlinearElimination {
 public:
     // pattern: the objective's Hessian pattern (upper triangle), from which the coupling graph is built once;
-    // median_floor: the local solves' SolverOptions::median_floor (the global Newton's).
-    NonlinearElimination(const Eigen::SparseMatrix<double>& pattern, EliminationOptions opt, bool median_floor = false);
+    // median_floor, max_step: the local solves' SolverOptions::median_floor and max_step (the global Newton's: a step
+    // cap that keeps a smooth wet energy's trials within its neighbour list holds for the local solves too).
+    NonlinearElimination(const Eigen::SparseMatrix<double>& pattern, EliminationOptions opt, bool median_floor = false,
+                         double max_step = 0);
 
     // Picks the parts from the gradient g at the current state; false (no parts) when nothing is hot beyond the grown
     // set's size limit or max|g| is zero.
@@ -63,6 +65,7 @@ public:
 private:
     EliminationOptions opt_;
     bool median_floor_;
+    double max_step_;
     std::vector<int> adj_start_, adj_;  // symmetric coupling graph over the coordinates
     std::vector<std::vector<int>> parts_;
     int selected_ = 0;

@@ -35,6 +35,8 @@ public:
     // Whether the list still holds every pair within `range` at x in the box B (built, same B, every node within
     // skin / 2 of where it was at the build).
     bool valid(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
+    // valid() for a state that differs from one where the list is valid only at `nodes` (a region's local solve).
+    bool valid_at(const std::vector<int>& nodes, const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
     const std::vector<SegmentPair>& pairs() const { return pairs_; }
     int builds() const { return builds_; }
     double skin() const { return skin_; }

@@ -28,6 +28,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "fibernet/energy/network_region.hpp"
 #include "fibernet/wet/bridge.hpp"
 #include "fibernet/wet/capillary_pair.hpp"
 #include "fibernet/wet/neighbour_list.hpp"
@@ -62,6 +63,9 @@ public:
     double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override;
     double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool project_psd) override;
     const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
+    // The energy of the coordinates `coords` alone, at the cost of their elements (Objective::restriction; nonlinear
+    // elimination): a SmoothWetRegion (smooth_wet_region.hpp), or the dry NetworkRegion at beta = 0.
+    std::unique_ptr<Objective> restriction(const Eigen::VectorXd& q, const std::vector<int>& coords) override;
 
     // Rebuilds the neighbour list and the Hessian pattern at q.
     void rebuild(const Eigen::VectorXd& q);
@@ -85,6 +89,7 @@ public:
     std::vector<Bridge> bridges(const Eigen::VectorXd& q, double* crossing_weight = nullptr) const;
 
 private:
+    friend class SmoothWetRegion;
     double eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd);
     bool active() const { return params_.pair.beta != 0; }
     bool wet_crossing(const SegmentPair& p) const;
@@ -103,6 +108,7 @@ private:
         std::vector<double> kappa;    // per saturating segment: d2E / dC_a^2 = -S''(n_a) / (2 beta l_a) >= 0
         std::vector<double> n;        // per segment: n_a
         double crossing = 0, contact = 0;  // the crossing terms' energy and the capped contact energy
+        std::vector<double> pair_crossing, pair_contact;  // per entry of `on`: the pair's crossing and contact energy
     };
     bool capped() const { return params_.bundle_partners > 0; }
     PartnerCap partner_cap(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on) const;
@@ -125,6 +131,8 @@ private:
     // Whether the pair at X is surely zero from its segments' bounding boxes alone (farther apart than the support).
     bool beyond_support(const Vector8d& X) const;
     static std::uint64_t key(const SegmentPair& p);
+    // Per segment, the indices of the listed pairs that hold it (compressed rows over the list now in use).
+    void index_segment_pairs() const;
 
     const NetworkEnergy& dry_;
     Eigen::Matrix2d F_;
@@ -148,6 +156,9 @@ private:
     std::vector<Matrix8d, Eigen::aligned_allocator<Matrix8d>> chunk_H_;
     std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>> contact_grad_;  // per non-zero pair (partner cap)
     std::vector<int> seg_fiber_, seg_index_;  // per segment: fiber and index in its chain
+    mutable std::vector<int> seg_pair_start_, seg_pair_;  // index_segment_pairs()
+    mutable int seg_pair_list_ = -1;                      // the list build they index
+    std::shared_ptr<const NodeElements> incidence_;       // built on the first restriction()
 };
 
 }  // namespace fibernet

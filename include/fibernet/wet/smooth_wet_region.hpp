@@ -1,0 +1,77 @@
+#pragma once
+// The smooth wet energy (smooth_wet_energy.hpp) restricted to a set of coordinates, every other one held
+// (Objective::restriction; issue 23, nonlinear elimination, solve/nonlinear_elimination.hpp). Evaluated at the cost of
+// the set's elements: the dry segments and hinges at its nodes (NetworkRegion) and the segment pairs of the energy's
+// neighbour list that hold a segment with a node in the set ("moving" pairs). Up to a constant (the held elements) its
+// value, gradient and Hessian are the whole energy's restricted to the set.
+//
+// Partner cap (bundle_saturation.hpp): E_contact = sum_a -(beta / 2) l_a S(n_a) couples a segment's pairs through n_a,
+// so the region also evaluates every listed pair of each segment that a moving pair holds, for those segments' n_a;
+// their own pair terms are constant. The saturation coupling kappa_a G_a G_a^T (G_a over the moving pairs of a) gets
+// pattern blocks between the moving pairs of each such segment.
+//
+// The neighbour list is the energy's: valid while the set's nodes stay within half the skin of the list's build (the
+// held nodes do not move). An evaluation beyond that rebuilds the energy's list at the region's state (a rebuild never
+// changes the energy) and takes the moving pairs anew; a Hessian that then meets a non-zero pair outside the region's
+// pattern (built with the first list) leaves that block out, as the whole energy does (pattern_stale()).
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <vector>
+
+#include "fibernet/energy/network_region.hpp"
+#include "fibernet/energy/objective.hpp"
+#include "fibernet/wet/smooth_wet_energy.hpp"
+
+namespace fibernet {
+
+class SmoothWetEnergy;
+
+class SmoothWetRegion : public Objective {
+public:
+    // W's energy over the coordinates `coords` of q (sorted, distinct). Keeps references to W and inc.
+    SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, const Eigen::VectorXd& q, const std::vector<int>& coords);
+
+    int size() const override { return static_cast<int>(coords_.size()); }
+    double value(const Eigen::VectorXd& qa) override { return eval(qa, nullptr, nullptr, false); }
+    double gradient(const Eigen::VectorXd& qa, Eigen::VectorXd& g) override { return eval(qa, &g, nullptr, false); }
+    double hessian(const Eigen::VectorXd& qa, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool psd) override {
+        return eval(qa, &g, &H, psd);
+    }
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
+    bool pattern_stale() const { return stale_; }
+    // Listed pairs the region evaluates (moving ones first use), for tests.
+    int moving_pairs() const { return n_moving_; }
+
+private:
+    double eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd);
+    // The moving pairs and, with the cap, the other pairs of their segments, from W's list as it is now.
+    void take_pairs();
+    void place(const Eigen::VectorXd& qa);  // the region's coordinates into x_
+    // The capped capillary energy of the region, up to a constant (pc over the non-zero taken pairs `on`, list indices;
+    // on_i their indices into pairs_).
+    double capped_energy(const SmoothWetEnergy::PartnerCap& pc, const std::vector<int>& on_i,
+                         const std::vector<int>& on) const;
+
+    SmoothWetEnergy& W_;
+    const NodeElements& inc_;
+    std::vector<int> coords_, coord_x_;  // region coordinate -> coordinate of q, and its entry of x_
+    std::vector<int> nodes_;             // the region's nodes
+    std::vector<int> segs_;              // segments with a node in the region
+    std::vector<char> in_region_;        // per segment: it has a node in the region
+    Eigen::VectorXd x_;                  // node positions of the whole network (the held ones as at construction)
+    Eigen::VectorXd xref_;               // per region coordinate: its node's reference coordinate
+    Eigen::Matrix2d B_;
+    NetworkRegion dry_;
+    // The pairs taken (indices into W's list, in list order), whether each is moving, and per moving pair the region
+    // index of its 8 local coordinates (-1: held).
+    std::vector<int> pairs_;
+    std::vector<char> moving_;
+    std::vector<int> idx_;      // 8 per taken pair
+    int n_moving_ = 0, list_build_ = -1;
+    Eigen::SparseMatrix<double> pattern_, dry_H_;
+    std::vector<int> dry_slot_;
+    bool stale_ = false;
+};
+
+}  // namespace fibernet
