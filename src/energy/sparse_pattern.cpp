@@ -58,6 +58,36 @@ int pattern_slot(const Eigen::SparseMatrix<double>& P, int r, int c) {
     return static_cast<int>(it - in);
 }
 
+int find_slot(const Eigen::SparseMatrix<double>& P, int r, int c) {
+    if (r > c) std::swap(r, c);
+    const int* in = P.innerIndexPtr();
+    const int b = P.outerIndexPtr()[c], e = P.outerIndexPtr()[c + 1];
+    const int* it = std::lower_bound(in + b, in + e, r);
+    return it != in + e && *it == r ? static_cast<int>(it - in) : -1;
+}
+
+bool add_outer_product(const Eigen::SparseMatrix<double>& P, std::vector<std::pair<int, double>>& G, double kappa,
+                       double* hv) {
+    std::sort(G.begin(), G.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
+    size_t w = 0;
+    for (size_t r = 0; r < G.size(); ++r) {
+        if (w > 0 && G[w - 1].first == G[r].first) G[w - 1].second += G[r].second;
+        else G[w++] = G[r];
+    }
+    G.resize(w);
+    bool complete = true;
+    for (size_t v = 0; v < G.size(); ++v)
+        for (size_t u = 0; u <= v; ++u) {
+            const int slot = find_slot(P, G[u].first, G[v].first);
+            if (slot < 0) {
+                complete = false;
+                continue;
+            }
+            hv[slot] += kappa * G[u].second * G[v].second;
+        }
+    return complete;
+}
+
 void element_slots(const Eigen::SparseMatrix<double>& P, const std::vector<int>& idx, int M, std::vector<int>& out) {
     const int n = static_cast<int>(P.cols());
     const size_t ne = idx.size() / M;

@@ -296,11 +296,9 @@ void SmoothWetEnergy::add_saturation_hessian(const PartnerCap& pc, const std::ve
                                              double* hv) {
     const std::vector<SegmentPair>& P = list_.pairs();
     const std::vector<std::vector<int>> pairs = saturating_pairs(pc, on);
-    const int* outer = pattern_.outerIndexPtr();
-    const int* inner = pattern_.innerIndexPtr();
     std::vector<std::pair<int, double>> G;
     for (size_t j = 0; j < pairs.size(); ++j) {
-        // G_a = grad C_a, merged by coordinate.
+        // G_a = grad C_a
         G.clear();
         for (int i : pairs[j]) {
             int idx[8];
@@ -308,26 +306,7 @@ void SmoothWetEnergy::add_saturation_hessian(const PartnerCap& pc, const std::ve
             for (int l = 0; l < 8; ++l)
                 if (idx[l] >= 0) G.emplace_back(idx[l], cgrad[i][l]);
         }
-        std::sort(G.begin(), G.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
-        size_t w = 0;
-        for (size_t r = 0; r < G.size(); ++r) {
-            if (w > 0 && G[w - 1].first == G[r].first) G[w - 1].second += G[r].second;
-            else G[w++] = G[r];
-        }
-        G.resize(w);
-        for (size_t v = 0; v < G.size(); ++v) {
-            const int col = G[v].first;
-            const int* lo = inner + outer[col];
-            const int* hi = inner + outer[col + 1];
-            for (size_t u = 0; u <= v; ++u) {
-                const int* it = std::lower_bound(lo, hi, G[u].first);
-                if (it == hi || *it != G[u].first) {
-                    stale_ = true;
-                    continue;
-                }
-                hv[it - inner] += pc.kappa[j] * G[u].second * G[v].second;
-            }
-        }
+        if (!add_outer_product(pattern_, G, pc.kappa[j], hv)) stale_ = true;
     }
 }
 

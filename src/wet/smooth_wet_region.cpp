@@ -11,17 +11,6 @@
 
 namespace fibernet {
 
-namespace {
-// The slot of entry (r, c) in P, or -1 if P lacks it.
-int find_slot(const Eigen::SparseMatrix<double>& P, int r, int c) {
-    if (r > c) std::swap(r, c);
-    const int* lo = P.innerIndexPtr() + P.outerIndexPtr()[c];
-    const int* hi = P.innerIndexPtr() + P.outerIndexPtr()[c + 1];
-    const int* it = std::lower_bound(lo, hi, r);
-    return it != hi && *it == r ? static_cast<int>(it - P.innerIndexPtr()) : -1;
-}
-}  // namespace
-
 SmoothWetRegion::SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, const Eigen::VectorXd& q,
                                  const std::vector<int>& coords)
     : W_(W), inc_(inc), coords_(coords), dry_(W.dry_, W.F_, inc, q, coords) {
@@ -254,25 +243,8 @@ double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eige
                 if (idx_[8 * i + a] >= 0) G[it->second].emplace_back(idx_[8 * i + a], cg[j][a]);
         }
     }
-    for (size_t s = 0; s < G.size(); ++s) {
-        auto& Gs = G[s];
-        std::sort(Gs.begin(), Gs.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
-        size_t w = 0;
-        for (size_t r = 0; r < Gs.size(); ++r) {
-            if (w > 0 && Gs[w - 1].first == Gs[r].first) Gs[w - 1].second += Gs[r].second;
-            else Gs[w++] = Gs[r];
-        }
-        Gs.resize(w);
-        for (size_t v = 0; v < Gs.size(); ++v)
-            for (size_t u = 0; u <= v; ++u) {
-                const int sl = find_slot(pattern_, Gs[u].first, Gs[v].first);
-                if (sl < 0) {
-                    stale_ = true;
-                    continue;
-                }
-                hv[sl] += pc.kappa[s] * Gs[u].second * Gs[v].second;
-            }
-    }
+    for (size_t s = 0; s < G.size(); ++s)
+        if (!add_outer_product(pattern_, G[s], pc.kappa[s], hv)) stale_ = true;
     return E;
 }
 

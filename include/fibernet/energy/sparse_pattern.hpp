@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <Eigen/SparseCore>
+#include <utility>
 #include <vector>
 
 namespace fibernet {
@@ -34,6 +35,14 @@ private:
 
 // Index into P's values of entry (r, c), r <= c; throws std::logic_error if P lacks it.
 int pattern_slot(const Eigen::SparseMatrix<double>& P, int r, int c);
+
+// The slot of entry (r, c) in P (either order), or -1 if P lacks it.
+int find_slot(const Eigen::SparseMatrix<double>& P, int r, int c);
+
+// Adds kappa G G^T to the values hv of the upper pattern P, G a sparse vector given as (coordinate, value) entries in
+// any order, with repeats (summed first, in coordinate order). Returns false if P lacks an entry (left out).
+bool add_outer_product(const Eigen::SparseMatrix<double>& P, std::vector<std::pair<int, double>>& G, double kappa,
+                       double* hv);
 
 // Value slots of many elements at once, each with M local coordinates: idx[e M + a] is local coordinate a's row/column
 // in P (-1: none). out (resized to elements x M x M) gets at e M M + a M + b the slot of (idx[e M + a], idx[e M + b])
