@@ -13,7 +13,7 @@ namespace fibernet {
 
 SmoothWetRegion::SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, const Eigen::VectorXd& q,
                                  const std::vector<int>& coords)
-    : W_(W), inc_(inc), coords_(coords), dry_(W.dry_, W.F_, inc, q, coords) {
+    : W_(W), coords_(coords), dry_(W.dry_, W.F_, inc, q, coords) {
     const Model& m = W.dry_.model();
     x_ = W.dry_.positions(q, W.F_);
     B_ = W.F_ * m.box.B0();
@@ -114,11 +114,9 @@ void SmoothWetRegion::take_pairs() {
     };
     moving_.assign(pairs_.size(), 0);
     idx_.assign(8 * pairs_.size(), -1);
-    n_moving_ = 0;
     for (size_t i = 0; i < pairs_.size(); ++i) {
         const SegmentPair& p = P[pairs_[i]];
         moving_[i] = in_region_[p.a] || in_region_[p.b];
-        n_moving_ += moving_[i];
         int node[4];
         Eigen::Vector2i shift[4];
         W_.list_.nodes(p, node, shift);

@@ -22,7 +22,7 @@ NodeElements node_elements(const NetworkEnergy& e);
 // The elements listed (compressed rows start/list, as in NodeElements) at any of `nodes`, sorted and distinct.
 std::vector<int> elements_at(const std::vector<int>& start, const std::vector<int>& list, const std::vector<int>& nodes);
 
-class NetworkRegion : public Objective {
+class NetworkRegion : public EvaluatedObjective {
 public:
     // e's energy at deformation F over the coordinates `coords` of q (sorted, distinct); the others stay at q.
     // Keeps references to e and inc.
@@ -30,15 +30,10 @@ public:
                   const std::vector<int>& coords);
 
     int size() const override { return static_cast<int>(coords_.size()); }
-    double value(const Eigen::VectorXd& qa) override { return eval(qa, nullptr, nullptr, false); }
-    double gradient(const Eigen::VectorXd& qa, Eigen::VectorXd& g) override { return eval(qa, &g, nullptr, false); }
-    double hessian(const Eigen::VectorXd& qa, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool psd) override {
-        return eval(qa, &g, &H, psd);
-    }
     const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
 
 private:
-    double eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd);
+    double eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) override;
 
     const NetworkEnergy& e_;
     Eigen::Matrix2d F_;

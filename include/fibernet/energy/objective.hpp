@@ -34,4 +34,18 @@ public:
     }
 };
 
+// An objective whose value, gradient and Hessian come from one evaluation (the regions of nonlinear elimination).
+class EvaluatedObjective : public Objective {
+public:
+    double value(const Eigen::VectorXd& q) override { return eval(q, nullptr, nullptr, false); }
+    double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override { return eval(q, &g, nullptr, false); }
+    double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool psd) override {
+        return eval(q, &g, &H, psd);
+    }
+
+protected:
+    // The value, and the gradient and the Hessian where asked for (non-null).
+    virtual double eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) = 0;
+};
+
 }  // namespace fibernet

@@ -27,24 +27,17 @@ namespace fibernet {
 
 class SmoothWetEnergy;
 
-class SmoothWetRegion : public Objective {
+class SmoothWetRegion : public EvaluatedObjective {
 public:
-    // W's energy over the coordinates `coords` of q (sorted, distinct). Keeps references to W and inc.
+    // W's energy over the coordinates `coords` of q (sorted, distinct). Keeps a reference to W.
     SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, const Eigen::VectorXd& q, const std::vector<int>& coords);
 
     int size() const override { return static_cast<int>(coords_.size()); }
-    double value(const Eigen::VectorXd& qa) override { return eval(qa, nullptr, nullptr, false); }
-    double gradient(const Eigen::VectorXd& qa, Eigen::VectorXd& g) override { return eval(qa, &g, nullptr, false); }
-    double hessian(const Eigen::VectorXd& qa, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool psd) override {
-        return eval(qa, &g, &H, psd);
-    }
     const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
     bool pattern_stale() const { return stale_; }
-    // Listed pairs the region evaluates (moving ones first use), for tests.
-    int moving_pairs() const { return n_moving_; }
 
 private:
-    double eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd);
+    double eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) override;
     // The moving pairs and, with the cap, the other pairs of their segments, from W's list as it is now.
     void take_pairs();
     void place(const Eigen::VectorXd& qa);  // the region's coordinates into x_
@@ -54,7 +47,6 @@ private:
                          const std::vector<int>& on) const;
 
     SmoothWetEnergy& W_;
-    const NodeElements& inc_;
     std::vector<int> coords_, coord_x_;  // region coordinate -> coordinate of q, and its entry of x_
     std::vector<int> nodes_;             // the region's nodes
     std::vector<int> segs_;              // segments with a node in the region
@@ -68,7 +60,7 @@ private:
     std::vector<int> pairs_;
     std::vector<char> moving_;
     std::vector<int> idx_;      // 8 per taken pair
-    int n_moving_ = 0, list_build_ = -1;
+    int list_build_ = -1;
     Eigen::SparseMatrix<double> pattern_, dry_H_;
     std::vector<int> dry_slot_;
     bool stale_ = false;
