@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 
@@ -69,6 +70,24 @@ struct Frame {
     double mean_reach = 1;
 };
 
+// Segment k's ends and reach at x (not yet wrapped).
+SegInfo segment_info(const Model& m, int k, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+                     const std::function<double(double)>& range, double skin) {
+    const Segment& s = m.segments[k];
+    SegInfo g;
+    g.p0 = x.segment<2>(2 * s.i), g.p1 = x.segment<2>(2 * s.j) + B * s.shift.cast<double>();
+    g.reach = range(1.5 * (g.p1 - g.p0).norm() + skin) + 0.5 * skin;
+    return g;
+}
+
+// Moves a periodic segment's ends next to its wrapped midpoint.
+void wrap_segment(SegInfo& g, const Frame& fr) {
+    const Eigen::Vector2d f = fr.Gi * (0.5 * (g.p0 + g.p1));
+    g.wrap = Eigen::Vector2i(static_cast<int>(std::floor(f.x())), static_cast<int>(std::floor(f.y())));
+    const Eigen::Vector2d t = fr.G * g.wrap.cast<double>();
+    g.p0 -= t, g.p1 -= t;
+}
+
 Frame segment_frame(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
                     const std::function<double(double)>& range, double skin, std::vector<SegInfo>& seg) {
     const int ns = static_cast<int>(m.segments.size());
@@ -78,10 +97,8 @@ Frame segment_frame(const Model& m, const Eigen::VectorXd& x, const Eigen::Matri
     double reach_sum = 0;
     Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
     for (int k = 0; k < ns; ++k) {
-        const Segment& s = m.segments[k];
         SegInfo& g = seg[k];
-        g.p0 = x.segment<2>(2 * s.i), g.p1 = x.segment<2>(2 * s.j) + B * s.shift.cast<double>();
-        g.reach = range(1.5 * (g.p1 - g.p0).norm() + skin) + 0.5 * skin;
+        g = segment_info(m, k, x, B, range, skin);
         reach_sum += g.reach;
         lo = lo.cwiseMin(g.p0.cwiseMin(g.p1)), hi = hi.cwiseMax(g.p0.cwiseMax(g.p1));
     }
@@ -93,50 +110,56 @@ Frame segment_frame(const Model& m, const Eigen::VectorXd& x, const Eigen::Matri
     }
     fr.Gi = fr.G.inverse();
     if (m.box.periodic)
-        for (SegInfo& g : seg) {
-            const Eigen::Vector2d f = fr.Gi * (0.5 * (g.p0 + g.p1));
-            g.wrap = Eigen::Vector2i(static_cast<int>(std::floor(f.x())), static_cast<int>(std::floor(f.y())));
-            const Eigen::Vector2d t = fr.G * g.wrap.cast<double>();
-            g.p0 -= t, g.p1 -= t;
-        }
+        for (SegInfo& g : seg) wrap_segment(g, fr);
     return fr;
 }
 
 // Each segment's grown box entered into every cell of the grid it covers (cells about twice the mean reach a side,
 // widths measured across the box's sides), and per segment the cells it covers.
 struct Grid {
+    int nx = 1, ny = 1;
     std::vector<std::vector<Entry>> cell, covers;  // covers: k is the cell's index
 };
+
+// The cells (with wraps) that segment g's box grown by `grow` covers; false if some of it lies outside an open box's grid.
+bool cells_of(const SegInfo& g, double grow, const Frame& fr, const Grid& grid, bool periodic, std::vector<Entry>& out) {
+    out.clear();
+    bool inside = true;
+    const int nx = grid.nx, ny = grid.ny;
+    // The grown box's corners in grid coordinates (their bounding box there covers it in a sheared box too).
+    const Eigen::Vector2d blo = g.p0.cwiseMin(g.p1) - Eigen::Vector2d::Constant(grow) - fr.origin;
+    const Eigen::Vector2d bhi = g.p0.cwiseMax(g.p1) + Eigen::Vector2d::Constant(grow) - fr.origin;
+    Eigen::Vector2d flo(1e300, 1e300), fhi(-1e300, -1e300);
+    for (const Eigen::Vector2d& c : {blo, bhi, Eigen::Vector2d(blo.x(), bhi.y()), Eigen::Vector2d(bhi.x(), blo.y())}) {
+        const Eigen::Vector2d f = fr.Gi * c;
+        flo = flo.cwiseMin(f), fhi = fhi.cwiseMax(f);
+    }
+    const int x0 = static_cast<int>(std::floor(flo.x() * nx)), x1 = static_cast<int>(std::floor(fhi.x() * nx));
+    const int y0 = static_cast<int>(std::floor(flo.y() * ny)), y1 = static_cast<int>(std::floor(fhi.y() * ny));
+    for (int cy = y0; cy <= y1; ++cy)
+        for (int cx = x0; cx <= x1; ++cx) {
+            const int wx = static_cast<int>(std::floor(static_cast<double>(cx) / nx));
+            const int wy = static_cast<int>(std::floor(static_cast<double>(cy) / ny));
+            if (!periodic && (wx != 0 || wy != 0)) {
+                inside = false;
+                continue;
+            }
+            out.push_back({(cy - wy * ny) * nx + (cx - wx * nx), Eigen::Vector2i(wx, wy)});
+        }
+    return inside;
+}
 
 Grid cover_cells(const std::vector<SegInfo>& seg, const Frame& fr, bool periodic) {
     const int ns = static_cast<int>(seg.size());
     const double area = std::abs(fr.G.determinant()), side = std::max(2 * fr.mean_reach, 1e-9);
-    const int nx = std::max(1, static_cast<int>(std::floor(area / fr.G.col(1).norm() / side)));
-    const int ny = std::max(1, static_cast<int>(std::floor(area / fr.G.col(0).norm() / side)));
     Grid grid;
-    grid.cell.resize(static_cast<size_t>(nx) * ny);
+    grid.nx = std::max(1, static_cast<int>(std::floor(area / fr.G.col(1).norm() / side)));
+    grid.ny = std::max(1, static_cast<int>(std::floor(area / fr.G.col(0).norm() / side)));
+    grid.cell.resize(static_cast<size_t>(grid.nx) * grid.ny);
     grid.covers.resize(ns);
     for (int k = 0; k < ns; ++k) {
-        const SegInfo& g = seg[k];
-        // The grown box's corners in grid coordinates (their bounding box there covers it in a sheared box too).
-        const Eigen::Vector2d blo = g.p0.cwiseMin(g.p1) - Eigen::Vector2d::Constant(g.reach) - fr.origin;
-        const Eigen::Vector2d bhi = g.p0.cwiseMax(g.p1) + Eigen::Vector2d::Constant(g.reach) - fr.origin;
-        Eigen::Vector2d flo(1e300, 1e300), fhi(-1e300, -1e300);
-        for (const Eigen::Vector2d& c : {blo, bhi, Eigen::Vector2d(blo.x(), bhi.y()), Eigen::Vector2d(bhi.x(), blo.y())}) {
-            const Eigen::Vector2d f = fr.Gi * c;
-            flo = flo.cwiseMin(f), fhi = fhi.cwiseMax(f);
-        }
-        const int x0 = static_cast<int>(std::floor(flo.x() * nx)), x1 = static_cast<int>(std::floor(fhi.x() * nx));
-        const int y0 = static_cast<int>(std::floor(flo.y() * ny)), y1 = static_cast<int>(std::floor(fhi.y() * ny));
-        for (int cy = y0; cy <= y1; ++cy)
-            for (int cx = x0; cx <= x1; ++cx) {
-                const int wx = static_cast<int>(std::floor(static_cast<double>(cx) / nx));
-                const int wy = static_cast<int>(std::floor(static_cast<double>(cy) / ny));
-                if (!periodic && (wx != 0 || wy != 0)) continue;
-                const int ci = (cy - wy * ny) * nx + (cx - wx * nx);
-                grid.cell[static_cast<size_t>(ci)].push_back({k, Eigen::Vector2i(wx, wy)});
-                grid.covers[k].push_back({ci, Eigen::Vector2i(wx, wy)});
-            }
+        cells_of(seg[k], seg[k].reach, fr, grid, periodic, grid.covers[k]);
+        for (const Entry& c : grid.covers[k]) grid.cell[static_cast<size_t>(c.k)].push_back({k, c.t});
     }
     return grid;
 }
@@ -177,12 +200,30 @@ void pairs_of(int a, const Model& m, const std::vector<SegInfo>& seg, const Grid
 
 }  // namespace
 
+// What a full build keeps for update(): the grid's frame, the segments' cells and their ends, wraps and reaches as
+// last entered.
+struct NeighbourList::Cache {
+    Frame fr;
+    Grid grid;
+    std::vector<SegInfo> seg;
+};
+
+namespace {
+bool pair_less(const SegmentPair& p, const SegmentPair& q) {
+    if (p.a != q.a) return p.a < q.a;
+    if (p.b != q.b) return p.b < q.b;
+    if (p.image.x() != q.image.x()) return p.image.x() < q.image.x();
+    return p.image.y() < q.image.y();
+}
+bool pair_equal(const SegmentPair& p, const SegmentPair& q) { return p.a == q.a && p.b == q.b && p.image == q.image; }
+}  // namespace
+
 void NeighbourList::build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double skin) {
     const int ns = static_cast<int>(m_.segments.size());
     built_skin_ = std::max(skin, skin_);
     std::vector<SegInfo> seg;
     const Frame fr = segment_frame(m_, x, B, range_, built_skin_, seg);
-    const Grid grid = cover_cells(seg, fr, m_.box.periodic);
+    Grid grid = cover_cells(seg, fr, m_.box.periodic);
     std::vector<std::vector<SegmentPair>> found(ns);
     parallel_ranges(ns, ns >= 2048 ? thread_count() : 1, [&](size_t lo, size_t hi) {
         std::vector<int> seen_a(ns, -1);
@@ -197,6 +238,71 @@ void NeighbourList::build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, do
     for (const auto& f : found) pairs_.insert(pairs_.end(), f.begin(), f.end());
     x_built_ = x;
     B_built_ = B;
+    cache_ = std::make_shared<Cache>(Cache{fr, std::move(grid), std::move(seg)});
+    ++builds_;
+}
+
+void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& segments,
+                           const std::vector<int>& nodes) {
+    if (!cache_ || builds_ == 0 || B != B_built_ || x.size() != x_built_.size()) return build(x, B);
+    if (cache_.use_count() > 1) cache_ = std::make_shared<Cache>(*cache_);  // copies of this list keep theirs
+    Cache& c = *cache_;
+    const bool periodic = m_.box.periodic;
+    // Held nodes may lie skin / 2 from where they were built and move skin / 2 further; the segments' held nodes too:
+    // a pair's distance can change by 2 skins before the list is invalid (header).
+    const double extra = 2 * built_skin_;
+    std::vector<Entry> cells;
+    if (!periodic)  // an open box's grid covers the segments as built, with a margin: a segment beyond it needs a build
+        for (int a : segments) {
+            const SegInfo g = segment_info(m_, a, x, B, range_, built_skin_);
+            if (!cells_of(g, g.reach + extra, c.fr, c.grid, periodic, cells)) return build(x, B);
+        }
+    std::vector<char> in(m_.segments.size(), 0);
+    for (int a : segments) in[a] = 1;
+    // The segments entered anew at x.
+    for (int a : segments) {
+        for (const Entry& e : c.grid.covers[a]) {
+            std::vector<Entry>& cell = c.grid.cell[static_cast<size_t>(e.k)];
+            cell.erase(std::remove_if(cell.begin(), cell.end(), [&](const Entry& f) { return f.k == a && f.t == e.t; }),
+                       cell.end());
+        }
+        SegInfo g = segment_info(m_, a, x, B, range_, built_skin_);
+        if (periodic) wrap_segment(g, c.fr);
+        c.seg[a] = g;
+        cells_of(g, g.reach, c.fr, c.grid, periodic, c.grid.covers[a]);
+        for (const Entry& e : c.grid.covers[a]) c.grid.cell[static_cast<size_t>(e.k)].push_back({a, e.t});
+    }
+    std::vector<SegmentPair> found;
+    for (int a : segments) {
+        const SegInfo& A = c.seg[a];
+        cells_of(A, A.reach + extra, c.fr, c.grid, periodic, cells);
+        for (const Entry& ca : cells)
+            for (const Entry& eb : c.grid.cell[static_cast<size_t>(ca.k)]) {
+                const int b = eb.k;
+                if (b == a || m_.segments[b].fiber == m_.segments[a].fiber || (in[b] && b < a)) continue;
+                const Eigen::Vector2i rel = ca.t - eb.t;
+                const Eigen::Vector2i image = rel - c.seg[b].wrap + A.wrap;  // b's first node next to a's
+                SegmentPair p;
+                if (a < b) p.a = a, p.b = b, p.image = image;
+                else p.a = b, p.b = a, p.image = -image;
+                if (touch(m_.segments[p.a], m_.segments[p.b], p.image)) continue;
+                // b where it is now, in the frame of its cells
+                SegInfo Bn = segment_info(m_, b, x, B, range_, built_skin_);
+                const Eigen::Vector2d tt = c.fr.G * (rel - c.seg[b].wrap).cast<double>();
+                const double cut = std::max(A.reach, Bn.reach) + 0.5 * built_skin_ + extra;
+                if (segment_distance(A.p0, A.p1, Bn.p0 + tt, Bn.p1 + tt) >= cut) continue;
+                found.push_back(p);
+            }
+    }
+    std::sort(found.begin(), found.end(), pair_less);
+    found.erase(std::unique(found.begin(), found.end(), pair_equal), found.end());
+    pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(), [&](const SegmentPair& p) { return in[p.a] || in[p.b]; }),
+                 pairs_.end());
+    std::vector<SegmentPair> merged;
+    merged.reserve(pairs_.size() + found.size());
+    std::merge(pairs_.begin(), pairs_.end(), found.begin(), found.end(), std::back_inserter(merged), pair_less);
+    pairs_.swap(merged);
+    for (int v : nodes) x_built_.segment<2>(2 * v) = x.segment<2>(2 * v);
     ++builds_;
 }
 

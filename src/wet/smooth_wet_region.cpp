@@ -41,7 +41,6 @@ SmoothWetRegion::SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, co
     const double reach = std::sin((pp.angle_hi_deg + 15) * M_PI / 180);
     std::vector<int> el, sat, near;  // near: indices into pairs_
     for (size_t i = 0; i < pairs_.size(); ++i) {
-        if (!moving_[i]) continue;
         const Vector8d X = W_.list_.coordinates(P[pairs_[i]], x_, B_);
         const bool on = !W_.beyond_support(X) && !capillary_pair_vanishes(X, W_.wet_[pairs_[i]], pp);
         if (!on && segment_distance(X.segment<2>(0), X.segment<2>(2), X.segment<2>(4), X.segment<2>(6)) >=
@@ -51,18 +50,17 @@ SmoothWetRegion::SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, co
         el.insert(el.end(), &idx_[8 * i], &idx_[8 * i] + 8);
     }
     if (W_.capped()) {
-        std::vector<int> on;
-        for (int k : pairs_) on.push_back(k);
-        const std::vector<double> n = W_.partner_cap(x_, B_, on).n;
+        const CapState cs = cap_state(nonzero(), nullptr, nullptr);
         const double N = W_.params_.bundle_partners, h = kSaturationHalfWidth + 0.5;
-        std::vector<std::pair<int, int>> of_segment;  // (segment, index into pairs_)
+        std::vector<std::pair<int, int>> of_segment;  // (segment's place in cap_seg_, index into pairs_)
         for (int i : near) {
             const Vector8d X = W_.list_.coordinates(P[pairs_[i]], x_, B_);
             const Eigen::Vector2d d1 = X.segment<2>(2) - X.segment<2>(0), d2 = X.segment<2>(6) - X.segment<2>(4);
             const double cr = d1.x() * d2.y() - d1.y() * d2.x();
             if (cr * cr > reach * reach * d1.squaredNorm() * d2.squaredNorm()) continue;
-            for (const int s : {P[pairs_[i]].a, P[pairs_[i]].b})
-                if (std::abs(n[s] - N) < h) of_segment.emplace_back(s, i);
+            for (int side = 0; side < 2; ++side)
+                if (std::abs(cs.n[pair_seg_[2 * i + side]] - N) < h)
+                    of_segment.emplace_back(pair_seg_[2 * i + side], i);
         }
         std::sort(of_segment.begin(), of_segment.end());
         for (size_t u0 = 0; u0 < of_segment.size();) {
@@ -91,18 +89,9 @@ void SmoothWetRegion::take_pairs() {
     const std::vector<SegmentPair>& P = W_.list_.pairs();
     const std::vector<int>& start = W_.seg_pair_start_;
     const std::vector<int>& list = W_.seg_pair_;
-    // The segments whose pairs are taken: the region's, and with the cap every segment that a moving pair holds.
-    std::vector<int> segs = segs_;
-    if (W_.capped()) {
-        const size_t own = segs.size();
-        for (size_t r = 0; r < own; ++r)
-            for (int p = start[segs[r]]; p < start[segs[r] + 1]; ++p)
-                segs.push_back(P[list[p]].a == segs[r] ? P[list[p]].b : P[list[p]].a);
-        std::sort(segs.begin(), segs.end());
-        segs.erase(std::unique(segs.begin(), segs.end()), segs.end());
-    }
+    // The moving pairs: those of the region's segments.
     pairs_.clear();
-    for (int s : segs) pairs_.insert(pairs_.end(), list.begin() + start[s], list.begin() + start[s + 1]);
+    for (int s : segs_) pairs_.insert(pairs_.end(), list.begin() + start[s], list.begin() + start[s + 1]);
     std::sort(pairs_.begin(), pairs_.end());
     pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
     // Region index of coordinate c of node v, or -1 when it is held (or fixed).
@@ -112,52 +101,101 @@ void SmoothWetRegion::take_pairs() {
         const auto it = std::lower_bound(coords_.begin(), coords_.end(), d);
         return it != coords_.end() && *it == d ? static_cast<int>(it - coords_.begin()) : -1;
     };
-    moving_.assign(pairs_.size(), 0);
     idx_.assign(8 * pairs_.size(), -1);
     for (size_t i = 0; i < pairs_.size(); ++i) {
-        const SegmentPair& p = P[pairs_[i]];
-        moving_[i] = in_region_[p.a] || in_region_[p.b];
         int node[4];
         Eigen::Vector2i shift[4];
-        W_.list_.nodes(p, node, shift);
+        W_.list_.nodes(P[pairs_[i]], node, shift);
         for (int a = 0; a < 8; ++a) idx_[8 * i + a] = local(node[a / 2], a % 2);
     }
     list_build_ = W_.list_.builds();
+    if (W_.capped()) take_cap_segments();
 }
 
-double SmoothWetRegion::capped_energy(const SmoothWetEnergy::PartnerCap& pc, const std::vector<int>& on_i,
-                                      const std::vector<int>& on) const {
-    // The whole capped energy less a constant that does not depend on which pairs were taken: the crossing terms of
-    // the moving pairs; -(beta / 2) l_a S(n_a) of the region's segments; and for any other segment b that a moving
-    // pair holds, -(beta / 2) l_b [S(n_b) - S(n_b fixed)], n_b fixed from its pairs with held segments alone (its term
-    // less its value with the region's pairs at zero, which is that constant).
+void SmoothWetRegion::take_cap_segments() {
+    // The segments whose n enters: the region's and their partners (the other segment of a moving pair). A partner's
+    // pairs with held segments do not change while the region moves: their contact energy is summed once here.
     const std::vector<SegmentPair>& P = W_.list_.pairs();
     const Model& m = W_.dry_.model();
-    const double beta = W_.params_.pair.beta;
+    const CapillaryPairParams& pp = W_.params_.pair;
+    cap_seg_ = segs_;
+    for (int k : pairs_) cap_seg_.push_back(P[k].a), cap_seg_.push_back(P[k].b);
+    std::sort(cap_seg_.begin(), cap_seg_.end());
+    cap_seg_.erase(std::unique(cap_seg_.begin(), cap_seg_.end()), cap_seg_.end());
+    auto local_seg = [&](int s) {
+        return static_cast<int>(std::lower_bound(cap_seg_.begin(), cap_seg_.end(), s) - cap_seg_.begin());
+    };
+    pair_seg_.resize(2 * pairs_.size());
+    for (size_t i = 0; i < pairs_.size(); ++i)
+        pair_seg_[2 * i] = local_seg(P[pairs_[i]].a), pair_seg_[2 * i + 1] = local_seg(P[pairs_[i]].b);
+    fixed_C_.assign(cap_seg_.size(), 0.0);
+    const std::vector<int>& start = W_.seg_pair_start_;
+    const std::vector<int>& list = W_.seg_pair_;
+    for (size_t j = 0; j < cap_seg_.size(); ++j) {
+        const int b = cap_seg_[j];
+        if (in_region_[b]) continue;
+        for (int p = start[b]; p < start[b + 1]; ++p) {
+            const SegmentPair& pr = P[list[p]];
+            if (in_region_[pr.a] || in_region_[pr.b]) continue;  // a moving pair
+            const Vector8d X = W_.list_.coordinates(pr, x_, B_);
+            if (W_.beyond_support(X) || capillary_pair_vanishes(X, W_.wet_[list[p]], pp)) continue;
+            CapillaryPairParts parts;
+            capillary_pair_energy(X, m.segments[pr.a].l0, m.segments[pr.b].l0, W_.wet_[list[p]], pp, nullptr, nullptr,
+                                  false, &parts);
+            fixed_C_[j] += parts.contact_energy;
+        }
+    }
+}
+
+std::vector<int> SmoothWetRegion::nonzero() const {
+    const std::vector<SegmentPair>& P = W_.list_.pairs();
+    std::vector<int> on;
+    for (size_t i = 0; i < pairs_.size(); ++i) {
+        const Vector8d X = W_.list_.coordinates(P[pairs_[i]], x_, B_);
+        if (!W_.beyond_support(X) && !capillary_pair_vanishes(X, W_.wet_[pairs_[i]], W_.params_.pair))
+            on.push_back(static_cast<int>(i));
+    }
+    return on;
+}
+
+SmoothWetRegion::CapState SmoothWetRegion::cap_state(const std::vector<int>& on, double* E,
+                                                     std::vector<double>* contact) const {
+    // n_s = -C_s / (beta l_s) over the cap's segments, C_s summed in list order; the energy is the whole capped
+    // energy less a constant that does not depend on which pairs were taken: the crossing terms of the moving pairs,
+    // -(beta / 2) l_a S(n_a) of the region's segments, and -(beta / 2) l_b [S(n_b) - S(n_b fixed)] of a partner b,
+    // n_b fixed from its pairs with held segments alone (b's term less its value with the region's pairs at zero).
+    const std::vector<SegmentPair>& P = W_.list_.pairs();
+    const Model& m = W_.dry_.model();
+    const CapillaryPairParams& pp = W_.params_.pair;
+    const double beta = pp.beta;
     const int N = W_.params_.bundle_partners;
-    double E = 0;
-    std::unordered_map<int, double> fixed;  // segment b outside the region held by a moving pair -> C_b fixed
-    for (size_t j = 0; j < on.size(); ++j)
-        if (moving_[on_i[j]]) {
-            E += pc.pair_crossing[j];
-            for (const int s : {P[on[j]].a, P[on[j]].b})
-                if (!in_region_[s]) fixed.emplace(s, 0.0);
-        }
+    std::vector<double> C = fixed_C_;
+    double crossing = 0;
+    if (contact) contact->resize(on.size());
     for (size_t j = 0; j < on.size(); ++j) {
-        if (moving_[on_i[j]]) continue;
-        for (const int s : {P[on[j]].a, P[on[j]].b}) {
-            const auto it = fixed.find(s);
-            if (it != fixed.end()) it->second += pc.pair_contact[j];
-        }
+        const int i = on[j];
+        const SegmentPair& pr = P[pairs_[i]];
+        CapillaryPairParts parts;
+        capillary_pair_energy(W_.list_.coordinates(pr, x_, B_), m.segments[pr.a].l0, m.segments[pr.b].l0,
+                              W_.wet_[pairs_[i]], pp, nullptr, nullptr, false, &parts);
+        crossing += parts.crossing_energy;
+        C[pair_seg_[2 * i]] += parts.contact_energy, C[pair_seg_[2 * i + 1]] += parts.contact_energy;
+        if (contact) (*contact)[j] = parts.contact_energy;
     }
-    for (int a : segs_) E += -0.5 * beta * m.segments[a].l0 * bundle_saturation(pc.n[a], N).S;
-    std::vector<std::pair<int, double>> sorted(fixed.begin(), fixed.end());  // a fixed order of the sum
-    std::sort(sorted.begin(), sorted.end());
-    for (const auto& [b, C] : sorted) {
-        const double l = m.segments[b].l0;
-        E += -0.5 * beta * l * (bundle_saturation(pc.n[b], N).S - bundle_saturation(-C / (beta * l), N).S);
+    CapState cs;
+    cs.n.resize(cap_seg_.size()), cs.dS.resize(cap_seg_.size()), cs.kappa.assign(cap_seg_.size(), 0.0);
+    double e = crossing;
+    for (size_t j = 0; j < cap_seg_.size(); ++j) {
+        const double l = m.segments[cap_seg_[j]].l0;
+        cs.n[j] = -C[j] / (beta * l);
+        const Saturation st = bundle_saturation(cs.n[j], N);
+        cs.dS[j] = st.dS, cs.kappa[j] = -st.d2S / (2 * beta * l);
+        double share = -0.5 * beta * l * st.S;
+        if (!in_region_[cap_seg_[j]]) share -= -0.5 * beta * l * bundle_saturation(-fixed_C_[j] / (beta * l), N).S;
+        e += share;
     }
-    return E;
+    if (E) *E = e;
+    return cs;
 }
 
 void SmoothWetRegion::place(const Eigen::VectorXd& qa) {
@@ -167,8 +205,8 @@ void SmoothWetRegion::place(const Eigen::VectorXd& qa) {
 
 double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) {
     place(qa);
-    if (!W_.list_.valid_at(nodes_, x_, B_)) {  // the region left the list: W's list anew at this state
-        W_.list_.build(x_, B_);
+    if (!W_.list_.valid_at(nodes_, x_, B_)) {  // the region left the list: W's list anew for its segments
+        W_.list_.update(x_, B_, segs_, nodes_);
         W_.index_list();
     }
     if (list_build_ != W_.list_.builds()) take_pairs();
@@ -187,32 +225,29 @@ double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eige
     const std::vector<SegmentPair>& P = W_.list_.pairs();
     const Model& m = W_.dry_.model();
     const CapillaryPairParams& pp = W_.params_.pair;
-    // The non-zero pairs taken (indices into pairs_ and into W's list).
-    std::vector<int> on_i, on;
-    for (size_t i = 0; i < pairs_.size(); ++i) {
-        const Vector8d X = W_.list_.coordinates(P[pairs_[i]], x_, B_);
-        if (!W_.beyond_support(X) && !capillary_pair_vanishes(X, W_.wet_[pairs_[i]], pp))
-            on_i.push_back(static_cast<int>(i)), on.push_back(pairs_[i]);
-    }
+    const std::vector<int> on = nonzero();  // indices into pairs_
     const bool capped = W_.capped();
-    SmoothWetEnergy::PartnerCap pc;
+    CapState cs;
+    std::vector<double> contact;
     if (capped) {
-        pc = W_.partner_cap(x_, B_, on);
-        E += capped_energy(pc, on_i, on);
+        double Ecap = 0;
+        cs = cap_state(on, &Ecap, &contact);
+        E += Ecap;
         if (!g && !H) return E;
     }
-    const bool saturation = H && !pc.saturating.empty();
+    bool saturation = false;
+    for (double k : cs.kappa) saturation = saturation || (H && k != 0);
     std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>> cg(saturation ? on.size() : 0);
     Vector8d ge;
     Matrix8d he;
     int slot[64];
     for (size_t j = 0; j < on.size(); ++j) {
-        const int i = on_i[j];
-        if (!moving_[i]) continue;
-        const SegmentPair& p = P[on[j]];
+        const int i = on[j];
+        const SegmentPair& p = P[pairs_[i]];
+        const double scale = capped ? 0.5 * (cs.dS[pair_seg_[2 * i]] + cs.dS[pair_seg_[2 * i + 1]]) : 1.0;
         const double e = capillary_pair_energy(W_.list_.coordinates(p, x_, B_), m.segments[p.a].l0, m.segments[p.b].l0,
-                                               W_.wet_[on[j]], pp, g || H ? &ge : nullptr, H ? &he : nullptr, psd,
-                                               nullptr, capped ? pc.scale[j] : 1.0, saturation ? &cg[j] : nullptr);
+                                               W_.wet_[pairs_[i]], pp, g || H ? &ge : nullptr, H ? &he : nullptr, psd,
+                                               nullptr, scale, saturation ? &cg[j] : nullptr);
         if (!capped) E += e;
         if (!g && !H) continue;
         const int* idx = &idx_[8 * i];
@@ -227,22 +262,20 @@ double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eige
         scatter_element(idx, H ? slot : nullptr, 8, ge.data(), H ? he.data() : nullptr, g, hv);
     }
     if (!saturation) return E;
-    // The cap's coupling kappa_a G_a G_a^T, G_a the gradient of a's contact energy over its moving pairs.
-    std::unordered_map<int, int> which;
-    for (size_t s = 0; s < pc.saturating.size(); ++s) which[pc.saturating[s]] = static_cast<int>(s);
-    std::vector<std::vector<std::pair<int, double>>> G(pc.saturating.size());
+    // The cap's coupling kappa_s G_s G_s^T, G_s the gradient of s's contact energy over its moving pairs.
+    std::vector<std::vector<std::pair<int, double>>> G(cap_seg_.size());
     for (size_t j = 0; j < on.size(); ++j) {
-        const int i = on_i[j];
-        if (!moving_[i] || !pc.touching[j]) continue;
-        for (const int s : {P[on[j]].a, P[on[j]].b}) {
-            const auto it = which.find(s);
-            if (it == which.end()) continue;
+        const int i = on[j];
+        if (contact[j] == 0) continue;
+        for (int side = 0; side < 2; ++side) {
+            const int s = pair_seg_[2 * i + side];
+            if (cs.kappa[s] == 0) continue;
             for (int a = 0; a < 8; ++a)
-                if (idx_[8 * i + a] >= 0) G[it->second].emplace_back(idx_[8 * i + a], cg[j][a]);
+                if (idx_[8 * i + a] >= 0) G[s].emplace_back(idx_[8 * i + a], cg[j][a]);
         }
     }
     for (size_t s = 0; s < G.size(); ++s)
-        if (!add_outer_product(pattern_, G[s], pc.kappa[s], hv)) stale_ = true;
+        if (cs.kappa[s] != 0 && !add_outer_product(pattern_, G[s], cs.kappa[s], hv)) stale_ = true;
     return E;
 }
 

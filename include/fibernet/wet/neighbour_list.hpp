@@ -10,6 +10,7 @@
 // so every sum over them is the same on every platform and for any thread count.
 #include <Eigen/Core>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "fibernet/model/model.hpp"
@@ -29,6 +30,14 @@ public:
     // Rebuilds the list at node positions x (2 per node) in the box B (model units), with the skin given at
     // construction or, for this build, `skin` (>= that one).
     void build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double skin = 0);
+    // The list anew for the pairs that hold one of `segments`, at x, after the nodes `nodes` moved (a region's local
+    // solve: every other node must lie within skin / 2 of where it was built, and only `nodes` are recorded as built
+    // anew). The pairs are found on the grid of the last full build, within the range plus 2.5 skins (a pair's
+    // distance can change by 2 skins before the list is invalid again: its held nodes may lie skin / 2 from their build
+    // and move skin / 2 further), in O(the segments' neighbours) plus one pass over the pairs. Counts as a build.
+    // Without a full build before, or in another box: a full build at x.
+    void update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& segments,
+                const std::vector<int>& nodes);
     // The largest displacement of a node from its position at the last build (infinity if none or B differs).
     double max_displacement(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
     const Eigen::VectorXd& built_at() const { return x_built_; }
@@ -55,6 +64,8 @@ private:
     Eigen::VectorXd x_built_;
     Eigen::Matrix2d B_built_ = Eigen::Matrix2d::Zero();
     int builds_ = 0;
+    struct Cache;
+    std::shared_ptr<Cache> cache_;  // the last full build's grid, for update()
 };
 
 }  // namespace fibernet

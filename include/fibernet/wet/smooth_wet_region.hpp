@@ -5,14 +5,15 @@
 // neighbour list that hold a segment with a node in the set ("moving" pairs). Up to a constant (the held elements) its
 // value, gradient and Hessian are the whole energy's restricted to the set.
 //
-// Partner cap (bundle_saturation.hpp): E_contact = sum_a -(beta / 2) l_a S(n_a) couples a segment's pairs through n_a,
-// so the region also evaluates every listed pair of each segment that a moving pair holds, for those segments' n_a;
-// their own pair terms are constant. The saturation coupling kappa_a G_a G_a^T (G_a over the moving pairs of a) gets
-// pattern blocks between the moving pairs of each such segment.
+// Partner cap (bundle_saturation.hpp): E_contact = sum_a -(beta / 2) l_a S(n_a) couples a segment's pairs through n_a.
+// A moving pair's segment b outside the region (a partner) keeps its pairs with held segments, whose contact energy is
+// summed once when the pairs are taken; the region's energy then holds b's term less its value with the region's pairs
+// at zero, a constant that does not depend on which pairs were taken. The saturation coupling kappa_a G_a G_a^T (G_a
+// over the moving pairs of a) gets pattern blocks between the moving pairs of each segment near the blend.
 //
 // The neighbour list is the energy's: valid while the set's nodes stay within half the skin of the list's build (the
-// held nodes do not move). An evaluation beyond that rebuilds the energy's list at the region's state (a rebuild never
-// changes the energy) and takes the moving pairs anew; a Hessian that then meets a non-zero pair outside the region's
+// held nodes do not move). An evaluation beyond that updates the energy's list for the region's segments
+// (NeighbourList::update; a rebuild never changes the energy) and takes the moving pairs anew; a Hessian that then meets a non-zero pair outside the region's
 // pattern (built with the first list) leaves that block out, as the whole energy does (pattern_stale()).
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -38,13 +39,19 @@ public:
 
 private:
     double eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) override;
-    // The moving pairs and, with the cap, the other pairs of their segments, from W's list as it is now.
+    // The moving pairs from W's list as it is now, and with the cap their segments (take_cap_segments).
     void take_pairs();
+    void take_cap_segments();
     void place(const Eigen::VectorXd& qa);  // the region's coordinates into x_
-    // The capped capillary energy of the region, up to a constant (pc over the non-zero taken pairs `on`, list indices;
-    // on_i their indices into pairs_).
-    double capped_energy(const SmoothWetEnergy::PartnerCap& pc, const std::vector<int>& on_i,
-                         const std::vector<int>& on) const;
+    // The moving pairs that are non-zero at x_ (indices into pairs_).
+    std::vector<int> nonzero() const;
+    // The partner cap over the cap's segments (cap_seg_) at x_, from the non-zero moving pairs `on`: per segment n,
+    // S'(n) and the coupling kappa = -S''(n) / (2 beta l); E (if asked) gets the capped capillary energy of the region up
+    // to a constant, `contact` each pair's contact energy.
+    struct CapState {
+        std::vector<double> n, dS, kappa;
+    };
+    CapState cap_state(const std::vector<int>& on, double* E, std::vector<double>* contact) const;
 
     SmoothWetEnergy& W_;
     std::vector<int> coords_, coord_x_;  // region coordinate -> coordinate of q, and its entry of x_
@@ -55,11 +62,14 @@ private:
     Eigen::VectorXd xref_;               // per region coordinate: its node's reference coordinate
     Eigen::Matrix2d B_;
     NetworkRegion dry_;
-    // The pairs taken (indices into W's list, in list order), whether each is moving, and per moving pair the region
-    // index of its 8 local coordinates (-1: held).
+    // The moving pairs (indices into W's list, in list order) and the region index of their 8 local coordinates
+    // (-1: held).
     std::vector<int> pairs_;
-    std::vector<char> moving_;
-    std::vector<int> idx_;      // 8 per taken pair
+    std::vector<int> idx_;      // 8 per pair
+    // The partner cap: the region's segments and their partners (ascending), per pair its two segments' places there,
+    // and per segment the contact energy of its pairs with held segments (0 for the region's own).
+    std::vector<int> cap_seg_, pair_seg_;
+    std::vector<double> fixed_C_;
     int list_build_ = -1;
     Eigen::SparseMatrix<double> pattern_, dry_H_;
     std::vector<int> dry_slot_;
