@@ -248,14 +248,16 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
     if (cache_.use_count() > 1) cache_ = std::make_shared<Cache>(*cache_);  // copies of this list keep theirs
     Cache& c = *cache_;
     const bool periodic = m_.box.periodic;
-    // Held nodes may lie skin / 2 from where they were built and move skin / 2 further; the segments' held nodes too:
-    // a pair's distance can change by 2 skins before the list is invalid (header).
-    const double extra = 2 * built_skin_;
+    // A held node (of either segment) may lie skin / 2 from where it was built and move skin / 2 further, so a pair's
+    // distance can change by 2 skins before the list is invalid: pairs are kept within range + 2 skins (one more than
+    // a build's range + skin). The grid holds held segments where they were entered, up to skin / 2 from where they
+    // are now, and the cells are searched a further skin out.
+    const double extra = built_skin_, grow = 2 * built_skin_;
     std::vector<Entry> cells;
     if (!periodic)  // an open box's grid covers the segments as built, with a margin: a segment beyond it needs a build
         for (int a : segments) {
             const SegInfo g = segment_info(m_, a, x, B, range_, built_skin_);
-            if (!cells_of(g, g.reach + extra, c.fr, c.grid, periodic, cells)) return build(x, B);
+            if (!cells_of(g, g.reach + grow, c.fr, c.grid, periodic, cells)) return build(x, B);
         }
     std::vector<char> in(m_.segments.size(), 0);
     for (int a : segments) in[a] = 1;
@@ -275,7 +277,7 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
     std::vector<SegmentPair> found;
     for (int a : segments) {
         const SegInfo& A = c.seg[a];
-        cells_of(A, A.reach + extra, c.fr, c.grid, periodic, cells);
+        cells_of(A, A.reach + grow, c.fr, c.grid, periodic, cells);
         for (const Entry& ca : cells)
             for (const Entry& eb : c.grid.cell[static_cast<size_t>(ca.k)]) {
                 const int b = eb.k;

@@ -273,7 +273,6 @@ SmoothWetEnergy::PartnerCap SmoothWetEnergy::partner_cap(const Eigen::VectorXd& 
     }
     pc.scale.resize(n), pc.touching.resize(n);
     for (size_t i = 0; i < n; ++i) pc.scale[i] = 0.5 * (dS[P[on[i]].a] + dS[P[on[i]].b]), pc.touching[i] = Ec[i] != 0;
-    pc.pair_crossing.swap(Ex), pc.pair_contact.swap(Ec);
     return pc;
 }
 

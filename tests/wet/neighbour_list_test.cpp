@@ -134,10 +134,11 @@ TEST_CASE("neighbour list: every pair within range, built and updated", "[wet][n
 
 TEST_CASE("neighbour list: update() lists the pairs that held nodes' drift and the region's can bring into range",
           "[wet][neighbour_list]") {
-    // Two parallel fibers, 5 apart (not listed). At the update the held fiber has drifted 0.247 away from where the
-    // region (the other fiber) is put, 1.35 from it: beyond range + skin (1.3), so a build would not list the pair.
-    // Then the held fiber drifts 0.247 the other way (within half the skin of its build) and the region 0.247 toward
-    // it: 0.61 apart, within range. update() must have listed the pair.
+    // Two parallel fibers, 5 apart (not listed). At the update the held fiber has drifted 0.2475 away from where the
+    // region (the other fiber) is put, 1.54 from it: beyond range + skin (1.3), so a build would not list the pair.
+    // Then the held fiber drifts 0.2475 the other way (within half the skin of its build) and the region 0.2475 toward
+    // it: 0.7975 apart, within range. update() must have listed the pair: a margin of 1.5 skins beyond the range is
+    // needed here (2 where the moved segment also has a held node).
     const Model m = model_of(network_of({{1.5, 1.5, 0, 1, 0.5}, {1.5, 2.0, 0, 1, 0.5}}, 3));
     const Eigen::Matrix2d B = m.box.B0();
     const Eigen::VectorXd x = m.x;
@@ -153,7 +154,7 @@ TEST_CASE("neighbour list: update() lists the pairs that held nodes' drift and t
     const double drift = 0.99 * kSkin / 2;
     Eigen::VectorXd xu = x;
     for (int v : held) xu[2 * v + 1] -= drift;
-    for (int v : region) xu[2 * v + 1] = x[2 * held[0] + 1] - drift + 1.35;
+    for (int v : region) xu[2 * v + 1] = x[2 * held[0] + 1] - drift + 1.54;
     list.update(xu, B, segs, region);
     Eigen::VectorXd xf = xu;
     for (int v : held) xf[2 * v + 1] = x[2 * v + 1] + drift;

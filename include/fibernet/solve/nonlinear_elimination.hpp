@@ -44,8 +44,8 @@ struct EliminationCounts {
 class NonlinearElimination {
 public:
     // pattern: the objective's Hessian pattern (upper triangle), from which the coupling graph is built once;
-    // median_floor, max_step: the local solves' SolverOptions::median_floor and max_step (the global Newton's: a step
-    // cap that keeps a smooth wet energy's trials within its neighbour list holds for the local solves too).
+    // median_floor, max_step: the local solves' SolverOptions::median_floor and max_step (the global Newton's: the
+    // smooth wet energy caps steps at its list's skin so that few trials leave the list, in local solves too).
     NonlinearElimination(const Eigen::SparseMatrix<double>& pattern, EliminationOptions opt, bool median_floor = false,
                          double max_step = 0);
 

@@ -31,11 +31,12 @@ public:
     // construction or, for this build, `skin` (>= that one).
     void build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double skin = 0);
     // The list anew for the pairs that hold one of `segments`, at x, after the nodes `nodes` moved (a region's local
-    // solve: every other node must lie within skin / 2 of where it was built, and only `nodes` are recorded as built
-    // anew). The pairs are found on the grid of the last full build, within the range plus 2.5 skins (a pair's
-    // distance can change by 2 skins before the list is invalid again: its held nodes may lie skin / 2 from their build
-    // and move skin / 2 further), in O(the segments' neighbours) plus one pass over the pairs. Counts as a build.
-    // Without a full build before, or in another box: a full build at x.
+    // solve). `segments` must hold every segment with a node in `nodes`, and every other node must lie within skin / 2
+    // of where it was built; only `nodes` are recorded as built anew. The pairs are found on the grid of the last full
+    // build and kept within the range plus 2 skins (a pair's distance can change by 2 skins before the list is invalid
+    // again: a held node may lie skin / 2 from its build and move skin / 2 further), at the cost of the segments'
+    // neighbours plus one pass over the pairs. Counts as a build. Without a full build before, in another box, or with
+    // a segment beyond an open box's grid: a full build at x.
     void update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& segments,
                 const std::vector<int>& nodes);
     // The largest displacement of a node from its position at the last build (infinity if none or B differs).

@@ -108,7 +108,6 @@ private:
         std::vector<double> kappa;    // per saturating segment: d2E / dC_a^2 = -S''(n_a) / (2 beta l_a) >= 0
         std::vector<double> n;        // per segment: n_a
         double crossing = 0, contact = 0;  // the crossing terms' energy and the capped contact energy
-        std::vector<double> pair_crossing, pair_contact;  // per entry of `on`: the pair's crossing and contact energy
     };
     bool capped() const { return params_.bundle_partners > 0; }
     PartnerCap partner_cap(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on) const;
