@@ -82,6 +82,23 @@ SmoothWetRegion::SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, co
     pattern_ = builder.build();
     dry_H_ = dry_.hessian_pattern();
     dry_slot_ = subpattern_slots(pattern_, dry_H_);
+    slot_pairs();
+}
+
+void SmoothWetRegion::slot_pairs() {
+    // Per pair the slots of its upper block in the pattern (element_slots' layout), -1 where the pattern lacks one.
+    slots_.assign(64 * pairs_.size(), -1);
+    unpatterned_.assign(pairs_.size(), 0);
+    for (size_t i = 0; i < pairs_.size(); ++i) {
+        const int* idx = &idx_[8 * i];
+        for (int a = 0; a < 8; ++a)
+            for (int b = 0; b < 8; ++b) {
+                if (idx[a] < 0 || idx[b] < 0 || idx[a] > idx[b]) continue;
+                const int sl = find_slot(pattern_, idx[a], idx[b]);
+                slots_[64 * i + 8 * a + b] = sl;
+                if (sl < 0) unpatterned_[i] = 1;
+            }
+    }
 }
 
 void SmoothWetRegion::take_pairs() {
@@ -209,7 +226,7 @@ double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eige
         W_.list_.update(x_, B_, segs_, nodes_);
         W_.index_list();
     }
-    if (list_build_ != W_.list_.builds()) take_pairs();
+    if (list_build_ != W_.list_.builds()) take_pairs(), slot_pairs();
     double E = 0;
     double* hv = nullptr;
     if (H) {
@@ -240,7 +257,6 @@ double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eige
     std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>> cg(saturation ? on.size() : 0);
     Vector8d ge;
     Matrix8d he;
-    int slot[64];
     for (size_t j = 0; j < on.size(); ++j) {
         const int i = on[j];
         const SegmentPair& p = P[pairs_[i]];
@@ -250,16 +266,8 @@ double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eige
                                                nullptr, scale, saturation ? &cg[j] : nullptr);
         if (!capped) E += e;
         if (!g && !H) continue;
-        const int* idx = &idx_[8 * i];
-        if (H)
-            for (int a = 0; a < 8; ++a)
-                for (int b = 0; b < 8; ++b) {
-                    slot[8 * a + b] = -1;
-                    if (idx[a] < 0 || idx[b] < 0 || idx[a] > idx[b]) continue;
-                    slot[8 * a + b] = find_slot(pattern_, idx[a], idx[b]);
-                    if (slot[8 * a + b] < 0) stale_ = true;
-                }
-        scatter_element(idx, H ? slot : nullptr, 8, ge.data(), H ? he.data() : nullptr, g, hv);
+        if (H && unpatterned_[i]) stale_ = true;
+        scatter_element(&idx_[8 * i], H ? &slots_[64 * i] : nullptr, 8, ge.data(), H ? he.data() : nullptr, g, hv);
     }
     if (!saturation) return E;
     // The cap's coupling kappa_s G_s G_s^T, G_s the gradient of s's contact energy over its moving pairs.

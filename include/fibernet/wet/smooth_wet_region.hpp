@@ -42,6 +42,7 @@ private:
     // The moving pairs from W's list as it is now, and with the cap their segments (take_cap_segments).
     void take_pairs();
     void take_cap_segments();
+    void slot_pairs();  // slots_ and unpatterned_ for the pairs taken
     void place(const Eigen::VectorXd& qa);  // the region's coordinates into x_
     // The moving pairs that are non-zero at x_ (indices into pairs_).
     std::vector<int> nonzero() const;
@@ -66,6 +67,8 @@ private:
     // (-1: held).
     std::vector<int> pairs_;
     std::vector<int> idx_;      // 8 per pair
+    std::vector<int> slots_;    // 64 per pair: value slots of its block in pattern_ (-1: none)
+    std::vector<char> unpatterned_;  // per pair: the pattern lacks part of its block
     // The partner cap: the region's segments and their partners (ascending), per pair its two segments' places there,
     // and per segment the contact energy of its pairs with held segments (0 for the region's own).
     std::vector<int> cap_seg_, pair_seg_;
