@@ -37,10 +37,13 @@ Eigen::SparseMatrix<double> PatternBuilder::build() const {
     }
     std::vector<int> outer(static_cast<size_t>(n_) + 1, 0), inner;
     inner.reserve(rows.size() / 2);
+    // Repeats dropped before the sort (elements that share coordinates repeat entries many times over).
+    std::vector<int> seen(static_cast<size_t>(n_), -1);
     for (int c = 0; c < n_; ++c) {
-        auto b = rows.begin() + start[c], e = rows.begin() + start[c + 1];
-        std::sort(b, e);
-        inner.insert(inner.end(), b, std::unique(b, e));
+        const size_t b = inner.size();
+        for (long k = start[c]; k < start[c + 1]; ++k)
+            if (seen[rows[k]] != c) seen[rows[k]] = c, inner.push_back(rows[k]);
+        std::sort(inner.begin() + static_cast<long>(b), inner.end());
         outer[c + 1] = static_cast<int>(inner.size());
     }
     std::vector<double> zeros(inner.size(), 0.0);
@@ -48,6 +51,13 @@ Eigen::SparseMatrix<double> PatternBuilder::build() const {
         n_, n_, static_cast<Eigen::Index>(inner.size()), outer.data(), inner.data(), zeros.data());
     P.makeCompressed();
     return P;
+}
+
+bool same_pattern(const Eigen::SparseMatrix<double>& A, const Eigen::SparseMatrix<double>& B) {
+    return A.rows() == B.rows() && A.cols() == B.cols() && A.nonZeros() == B.nonZeros() &&
+           A.isCompressed() && B.isCompressed() &&
+           std::equal(A.outerIndexPtr(), A.outerIndexPtr() + A.cols() + 1, B.outerIndexPtr()) &&
+           std::equal(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros(), B.innerIndexPtr());
 }
 
 int pattern_slot(const Eigen::SparseMatrix<double>& P, int r, int c) {

@@ -135,6 +135,12 @@ CholmodLDL::~CholmodLDL() = default;
 
 bool CholmodLDL::analyzed() const { return impl_->L != nullptr; }
 
+void CholmodLDL::forget() {
+    Impl& m = *impl_;
+    if (m.L) cholmod_free_factor(&m.L, &m.c);
+    m.ok = false, m.a = m.b = 0;
+}
+
 void CholmodLDL::analyze(const Eigen::SparseMatrix<double>& upper) {
     Impl& m = *impl_;
     if (m.L) cholmod_free_factor(&m.L, &m.c);

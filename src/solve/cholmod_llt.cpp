@@ -38,6 +38,11 @@ CholmodLLT::~CholmodLLT() = default;
 
 bool CholmodLLT::analyzed() const { return impl_->L != nullptr; }
 
+void CholmodLLT::forget() {
+    if (impl_->L) cholmod_free_factor(&impl_->L, &impl_->c);
+    impl_->n = -1, impl_->nnz = -1, impl_->ok = false;
+}
+
 void CholmodLLT::analyze(const Eigen::SparseMatrix<double>& upper) {
     if (impl_->L) cholmod_free_factor(&impl_->L, &impl_->c);
     cholmod_sparse A = view(upper);

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "fibernet/energy/sparse_pattern.hpp"
 #include "fibernet/solve/cholmod_llt.hpp"
 #include "fibernet/solve/newton_ladder.hpp"
 #include "fibernet/solve/solver_loop.hpp"
@@ -75,10 +76,7 @@ double roundoff_floor(const Eigen::SparseMatrix<double>& H, const Eigen::VectorX
 
 CholmodLLT& NewtonSolver::analyzed_for(const Eigen::SparseMatrix<double>& H, double* seconds) {
     // Symbolic analysis once per pattern (kept across calls while the pattern is the same).
-    const bool same = llt_ && analyzed_.rows() == H.rows() && analyzed_.nonZeros() == H.nonZeros() &&
-                      std::equal(H.outerIndexPtr(), H.outerIndexPtr() + H.cols() + 1, analyzed_.outerIndexPtr()) &&
-                      std::equal(H.innerIndexPtr(), H.innerIndexPtr() + H.nonZeros(), analyzed_.innerIndexPtr());
-    if (!same) {
+    if (!llt_ || !same_pattern(H, analyzed_)) {
         auto t0 = Clock::now();
         llt_ = std::make_unique<CholmodLLT>();
         analyzed_ = H;
@@ -97,13 +95,15 @@ namespace {
 class Newton : public IterativeMethod {
 public:
     Newton(const SolverOptions& opt, NewtonLadder& ladder, ModifiedLdlRung* ldl, double warm_shift_rel,
-           NewtonTrace& trace)
-        : opt_(opt), ladder_(ladder), ldl_(ldl), warm_shift_rel_(warm_shift_rel), trace_(trace) {}
+           NewtonTrace& trace, std::vector<LinearSolver*> factorizations)
+        : opt_(opt), ladder_(ladder), ldl_(ldl), warm_shift_rel_(warm_shift_rel), trace_(trace),
+          factorizations_(std::move(factorizations)) {}
 
     Step start(SolverRun& run, Eigen::VectorXd& q) override {
         Objective& f = run.objective();
         const int n = f.size();
         H_ = f.hessian_pattern();
+        version_ = f.pattern_version();
         g_.resize(n), gt_.resize(n), d_.resize(n), qt_.resize(n);
         if (opt_.eliminate && n > 0) ne_ = std::make_unique<NonlinearElimination>(H_, opt_.elimination, opt_.median_floor, opt_.max_step);
         if (opt_.projected) start_rung_ = 1;
@@ -137,6 +137,16 @@ public:
     }
 
 private:
+    // A Hessian in a new pattern (Objective::pattern_version): the factorizations analyze it at their next use, and
+    // elimination's coupling graph is rebuilt from it.
+    void follow_pattern(const Objective& f) {
+        const long v = f.pattern_version();
+        if (v == version_) return;
+        version_ = v;
+        for (LinearSolver* lin : factorizations_) lin->forget();
+        if (ne_) ne_->set_pattern(H_);
+    }
+
     // f, g, H at q (exact unless the last iteration needed the projected rungs), and the stop tests that need H.
     Step assemble(SolverRun& run, const Eigen::VectorXd& q, int it) {
         SolveResult& r = run.result();
@@ -144,6 +154,7 @@ private:
         projected_ = start_rung_ >= 1;
         fq_ = q.size() > 0 ? run.objective().hessian(q, g_, H_, projected_) : run.objective().value(q);
         r.timings.assembly += since(t0);
+        follow_pattern(run.objective());
         gmax_ = q.size() > 0 ? g_.lpNorm<Eigen::Infinity>() : 0.0;
         if (!std::isfinite(fq_) || !g_.allFinite())
             return Step::stop(SolveStatus::NonFinite, "non-finite energy or gradient at iteration " + std::to_string(it),
@@ -194,6 +205,7 @@ private:
         const auto ta = Clock::now();
         fq_ = run.objective().hessian(q, g_, H_, projected_);
         run.result().timings.assembly += since(ta);
+        follow_pattern(run.objective());
         gmax_ = q.size() > 0 ? g_.lpNorm<Eigen::Infinity>() : 0.0;
         if (!std::isfinite(fq_) || !g_.allFinite())
             return Step::stop(SolveStatus::NonFinite,
@@ -310,6 +322,8 @@ private:
     ModifiedLdlRung* ldl_;
     const double warm_shift_rel_;
     NewtonTrace& trace_;
+    const std::vector<LinearSolver*> factorizations_;  // the ladder's, analyzed for H_'s pattern
+    long version_ = 0;                                  // the objective's pattern_version() that H_ has
     std::unique_ptr<NonlinearElimination> ne_;
     Eigen::SparseMatrix<double> H_;
     Eigen::VectorXd g_, gt_, d_, qt_;
@@ -326,6 +340,7 @@ private:
 SolverCapabilities NewtonSolver::capabilities() const {
     SolverCapabilities c;
     c.hessian = c.ldl = c.projected = c.eliminate = c.warm_start = c.newton_steps = c.shares_factorization = true;
+    c.follows_pattern = true;
     return c;
 }
 
@@ -347,7 +362,9 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         run.result().timings.factorization += since(t0);
     }
     NewtonLadder ladder(llt, opt_.ldl ? ldl_.get() : nullptr, !opt_.projected);
-    Newton method(opt_, ladder, ladder.modified_ldl(), trace_.shift_rel, trace_);
+    std::vector<LinearSolver*> lins{&llt};
+    if (opt_.ldl && ldl_) lins.push_back(ldl_.get());
+    Newton method(opt_, ladder, ladder.modified_ldl(), trace_.shift_rel, trace_, lins);
     return run_iterations(run, method, q);
 }
 

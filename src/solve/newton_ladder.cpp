@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
 
 namespace fibernet {
 
@@ -36,7 +37,11 @@ void LadderState::make_projected() {
     if (projected) return;
     Eigen::VectorXd gt(g.size());
     const auto ta = std::chrono::steady_clock::now();
+    const long version = f.pattern_version();
     f.hessian(q, gt, H, true);
+    // At the q of the exact Hessian, whose pattern already holds every non-zero element there.
+    if (f.pattern_version() != version)
+        throw std::logic_error("Newton: the Hessian pattern changed between two evaluations at the same state");
     result.timings.assembly += since(ta);
     projected = true;
 }

@@ -23,6 +23,10 @@ NonlinearElimination::NonlinearElimination(const Eigen::SparseMatrix<double>& P,
                                            double max_step)
     : opt_(opt), median_floor_(median_floor), max_step_(max_step) {
     opt_.check("newton");
+    set_pattern(P);
+}
+
+void NonlinearElimination::set_pattern(const Eigen::SparseMatrix<double>& P) {
     const int n = static_cast<int>(P.cols());
     // Both triangles of the pattern, without the diagonal: coordinate i couples j when some element holds both.
     adj_start_.assign(n + 1, 0);

@@ -52,7 +52,7 @@ bool SolverRun::stop_test(int k, double grad_max, Step& out) const {
 }
 
 void SolverRun::tick(int k, double energy, double grad_max, const std::string& extra) {
-    if (!opt_.verbose) return;
+    if (!opt_.verbose && !opt_.progress) return;
     const double t = seconds();
     if (t < next_tick_) return;
     next_tick_ = t + 1.0;

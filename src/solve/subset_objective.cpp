@@ -6,7 +6,7 @@
 namespace fibernet {
 
 SubsetObjective::SubsetObjective(Objective& f, const Eigen::VectorXd& q, const std::vector<int>& coords)
-    : f_(f), coords_(coords), q_(q), H_(f.hessian_pattern()) {
+    : f_(f), coords_(coords), q_(q), H_(f.hessian_pattern()), version_(f.pattern_version()) {
     const int n = f.size();
     std::vector<int> local(n, -1);
     for (size_t k = 0; k < coords_.size(); ++k) {
@@ -53,6 +53,9 @@ double SubsetObjective::gradient(const Eigen::VectorXd& qa, Eigen::VectorXd& g) 
 double SubsetObjective::hessian(const Eigen::VectorXd& qa, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool psd) {
     embed(qa);
     const double E = f_.hessian(q_, g_, H_, psd);
+    // The slots index the pattern of construction.
+    if (f_.pattern_version() != version_)
+        throw std::logic_error("SubsetObjective: the objective's Hessian pattern changed (restrict it instead)");
     g.resize(size());
     for (int i = 0; i < size(); ++i) g[i] = g_[coords_[i]];
     if (H.nonZeros() != pattern_.nonZeros()) throw std::logic_error("SubsetObjective: Hessian lacks the subset's pattern");

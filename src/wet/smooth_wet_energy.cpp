@@ -17,6 +17,17 @@ namespace {
 constexpr size_t kParallelMin = 4096;
 constexpr size_t kChunk = 16384;
 
+// The squared distance between the bounding boxes of a pair's two segments (X: their nodes): a lower bound of the
+// segments' distance.
+double box_gap_squared(const Vector8d& X) {
+    const double ax0 = std::min(X[0], X[2]), ax1 = std::max(X[0], X[2]), ay0 = std::min(X[1], X[3]),
+                 ay1 = std::max(X[1], X[3]);
+    const double bx0 = std::min(X[4], X[6]), bx1 = std::max(X[4], X[6]), by0 = std::min(X[5], X[7]),
+                 by1 = std::max(X[5], X[7]);
+    const double gx = std::max({0.0, bx0 - ax1, ax0 - bx1}), gy = std::max({0.0, by0 - ay1, ay0 - by1});
+    return gx * gx + gy * gy;
+}
+
 }  // namespace
 
 SmoothWetEnergy::SmoothWetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, SmoothWetParams params,
@@ -73,15 +84,10 @@ void SmoothWetEnergy::index_list() const {
 }
 
 bool SmoothWetEnergy::beyond_support(const Vector8d& X) const {
-    const double ax0 = std::min(X[0], X[2]), ax1 = std::max(X[0], X[2]), ay0 = std::min(X[1], X[3]),
-                 ay1 = std::max(X[1], X[3]);
-    const double bx0 = std::min(X[4], X[6]), bx1 = std::max(X[4], X[6]), by0 = std::min(X[5], X[7]),
-                 by1 = std::max(X[5], X[7]);
-    const double gx = std::max({0.0, bx0 - ax1, ax0 - bx1}), gy = std::max({0.0, by0 - ay1, ay0 - by1});
     const double L = std::sqrt(std::max((X.segment<2>(2) - X.segment<2>(0)).squaredNorm(),
                                         (X.segment<2>(6) - X.segment<2>(4)).squaredNorm()));
     const double support = std::max(support_crossing_, support_contact_ + support_slope_ * L);
-    return gx * gx + gy * gy > support * support;
+    return box_gap_squared(X) > support * support;
 }
 
 void SmoothWetEnergy::ensure_list(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const {
@@ -107,19 +113,55 @@ void SmoothWetEnergy::rebuild(const Eigen::VectorXd& q) {
     const Eigen::VectorXd x = dry_.positions(q, F_);
     const Eigen::Matrix2d B = F_ * dry_.model().box.B0();
     list_.build(x, B);
-    build_pattern(x, B);
+    wet_.resize(list_.pairs().size());
+    for (size_t k = 0; k < wet_.size(); ++k) wet_[k] = wet_crossing(list_.pairs()[k]);
+    const std::vector<int> on = nonzero_pairs(x, B);
+    new_pattern(x, B, on, capped() ? partner_cap(x, B, on).n : std::vector<double>{});
+}
+
+void SmoothWetEnergy::new_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on,
+                                  const std::vector<double>& n) {
+    build_pattern(x, B, on, n);
     stale_ = false;
     pattern_list_ = list_.builds();
     ++pattern_builds_;
 }
 
+void SmoothWetEnergy::cover(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on,
+                            const std::vector<double>& n, Eigen::SparseMatrix<double>& H) {
+    bool covered = !stale_;
+    for (size_t i = 0; i < on.size() && covered; ++i) covered = patterned_[on[i]] >= 0;
+    if (!covered) new_pattern(x, B, on, n);
+    if (!same_pattern(H, pattern_)) H = pattern_;
+}
+
 std::vector<int> SmoothWetEnergy::nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const {
     const std::vector<SegmentPair>& P = list_.pairs();
+    // Each segment's bounding box and length once, so that most listed pairs (far from their support at any one
+    // state) are set aside by two boxes and an image offset (the test of beyond_support, whose boxes these are).
+    const Model& m = dry_.model();
+    struct Box {
+        double x0, x1, y0, y1, length;
+    };
+    std::vector<Box> box(m.segments.size());
+    for (size_t s = 0; s < m.segments.size(); ++s) {
+        const Segment& a = m.segments[s];
+        const Eigen::Vector2d p0 = x.segment<2>(2 * a.i), p1 = x.segment<2>(2 * a.j) + B * a.shift.cast<double>();
+        box[s] = {std::min(p0.x(), p1.x()), std::max(p0.x(), p1.x()), std::min(p0.y(), p1.y()),
+                  std::max(p0.y(), p1.y()), (p1 - p0).norm()};
+    }
     std::vector<char> on(P.size(), 0);
     parallel_ranges(P.size(), P.size() >= kParallelMin ? thread_count() : 1, [&](size_t lo, size_t hi) {
         for (size_t k = lo; k < hi; ++k) {
-            const Vector8d X = list_.coordinates(P[k], x, B);
-            on[k] = !beyond_support(X) && !capillary_pair_vanishes(X, wet_[k], params_.pair);
+            const Box& a = box[P[k].a];
+            const Box& b = box[P[k].b];
+            const Eigen::Vector2d t = B * P[k].image.cast<double>();
+            const double gx = std::max({0.0, b.x0 + t.x() - a.x1, a.x0 - b.x1 - t.x()});
+            const double gy = std::max({0.0, b.y0 + t.y() - a.y1, a.y0 - b.y1 - t.y()});
+            const double support =
+                std::max(support_crossing_, support_contact_ + support_slope_ * std::max(a.length, b.length));
+            if (gx * gx + gy * gy > support * support) continue;
+            on[k] = !capillary_pair_vanishes(list_.coordinates(P[k], x, B), wet_[k], params_.pair);
         }
     });
     std::vector<int> out;
@@ -128,17 +170,17 @@ std::vector<int> SmoothWetEnergy::nonzero_pairs(const Eigen::VectorXd& x, const 
     return out;
 }
 
-void SmoothWetEnergy::build_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) {
+void SmoothWetEnergy::build_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on,
+                                    const std::vector<double>& n) {
     const std::vector<SegmentPair>& P = list_.pairs();
-    wet_.resize(P.size());
-    for (size_t k = 0; k < P.size(); ++k) wet_[k] = wet_crossing(P[k]);
     std::vector<char> take(P.size(), 0);
-    for (int k : nonzero_pairs(x, B)) take[k] = 1;
+    for (int k : on) take[k] = 1;
     const double dp = params_.pattern_distance;
     for (size_t k = 0; k < P.size(); ++k) {
         if (take[k]) continue;
         const Vector8d X = list_.coordinates(P[k], x, B);
-        take[k] = segment_distance(X.segment<2>(0), X.segment<2>(2), X.segment<2>(4), X.segment<2>(6)) < dp;
+        take[k] = box_gap_squared(X) < dp * dp &&
+                  segment_distance(X.segment<2>(0), X.segment<2>(2), X.segment<2>(4), X.segment<2>(6)) < dp;
     }
     patterned_.assign(P.size(), -1);
     pattern_index_.clear();
@@ -153,7 +195,7 @@ void SmoothWetEnergy::build_pattern(const Eigen::VectorXd& x, const Eigen::Matri
         idx.insert(idx.end(), e, e + 8);
     }
     std::vector<int> partner_idx;
-    if (capped()) add_partner_blocks(take, x, B, partner_idx);
+    if (capped()) add_partner_blocks(take, x, B, n, partner_idx);
     const Eigen::SparseMatrix<double>& D = dry_.hessian_pattern();
     PatternBuilder builder(dry_.num_dofs());
     builder.add_pattern(D);
@@ -172,16 +214,23 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
         if (g) g->swap(eval_.gradient);
         return eval_.energy;
     }
-    if (H && H->nonZeros() != pattern_.nonZeros())
-        throw std::logic_error("SmoothWetEnergy: the Hessian lacks the energy's pattern");
     const Eigen::VectorXd x = dry_.positions(q, F_);
     const Eigen::Matrix2d B = F_ * dry_.model().box.B0();
     ensure_list(x, B);
     const std::vector<SegmentPair>& P = list_.pairs();
-    const std::vector<int> on = nonzero_pairs(x, B);
-    // With the partner cap, the energy and each pair's contact weight come from a first pass over the pairs' values.
-    PartnerCap pc;
-    if (capped()) pc = partner_cap(x, B, on);
+    // The non-zero pairs and, with the partner cap, the energy and each pair's contact weight (a first pass over the
+    // pairs' values): kept from the last evaluation at the same positions (Newton's Hessian at its line search's
+    // accepted trial).
+    if (!(at_.builds == list_.builds() && at_.x.size() == x.size() && (at_.x.array() == x.array()).all())) {
+        at_.x = x, at_.builds = list_.builds();
+        at_.on = nonzero_pairs(x, B);
+        at_.pc = capped() ? partner_cap(x, B, at_.on) : PartnerCap{};
+    }
+    const std::vector<int>& on = at_.on;
+    const PartnerCap& pc = at_.pc;
+    if (H && follow_) cover(x, B, on, pc.n, *H);
+    if (H && H->nonZeros() != pattern_.nonZeros())
+        throw std::logic_error("SmoothWetEnergy: the Hessian lacks the energy's pattern");
     const bool pairs_pass = g || H || !capped();
     const bool saturation_hessian = H && !pc.saturating.empty();
     // The non-zero pairs in chunks, each evaluated in parallel into its own slots and added in list order after the
@@ -234,6 +283,13 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
     }
     if (capped()) E += pc.crossing + pc.contact;
     if (saturation_hessian) add_saturation_hessian(pc, on, contact_grad_, hv);
+    if (H && follow_ && stale_ && !retrying_) {
+        // The cap's coupling met a block outside the pattern: the pattern of this state holds it (add_partner_blocks).
+        new_pattern(x, B, on, pc.n);
+        retrying_ = true;
+        E = eval(q, g, H, psd);
+        retrying_ = false;
+    }
     return E;
 }
 
@@ -310,13 +366,13 @@ void SmoothWetEnergy::add_saturation_hessian(const PartnerCap& pc, const std::ve
 }
 
 void SmoothWetEnergy::add_partner_blocks(const std::vector<char>& take, const Eigen::VectorXd& x,
-                                         const Eigen::Matrix2d& B, std::vector<int>& idx) const {
+                                         const Eigen::Matrix2d& B, const std::vector<double>& n,
+                                         std::vector<int>& idx) const {
     // Aligned: within 15 deg beyond the contact term's reach at the build; near the blend: n_a within 1/2 of it (the
     // coupling is kappa_a G_a G_a^T, non-zero only inside the blend). So the blocks cover the motion until the next
     // rebuild; a segment that saturates outside them marks the pattern stale.
     const double reach = std::sin((params_.pair.angle_hi_deg + 15) * M_PI / 180);
     const double N = params_.bundle_partners, h = kSaturationHalfWidth + 0.5;
-    const std::vector<double> n = partner_cap(x, B, nonzero_pairs(x, B)).n;
     const std::vector<SegmentPair>& P = list_.pairs();
     std::vector<std::vector<int>> partners(dry_.model().segments.size());
     for (size_t k = 0; k < P.size(); ++k) {

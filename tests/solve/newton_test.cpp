@@ -504,3 +504,81 @@ TEST_CASE("newton: an LDL^T direction that fails its line search is retried with
     CHECK(r.ldl_retries == 1);
     CHECK(f.value(q) < 0);
 }
+
+namespace {
+// f = sum_i (q_i - 1)^2 / 2 + k s(q_0) s(q_1), s(x) = max(0, x - 1/2)^3 (C2): the coupling of q_0 and q_1 is exactly
+// zero until both pass 1/2. Its Hessian pattern follows the state (Objective::pattern_version), like the smooth wet
+// energy's: the diagonal at first, the (0, 1) entry added by the first Hessian that needs it. With follow = false the
+// pattern holds that entry from the start and is fixed.
+class Coupling : public Objective {
+public:
+    Coupling(int n, bool follow) : n_(n), follow_(follow) { pattern_ = pattern(!follow); }
+    int size() const override { return n_; }
+    double value(const Eigen::VectorXd& q) override {
+        Eigen::VectorXd g;
+        return gradient(q, g);
+    }
+    double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override {
+        g = q.array() - 1.0;
+        const double s0 = s(q[0], 0), s1 = s(q[1], 0);
+        g[0] += k * s(q[0], 1) * s1, g[1] += k * s0 * s(q[1], 1);
+        return 0.5 * (q.array() - 1.0).square().sum() + k * s0 * s1;
+    }
+    double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool) override {
+        const double f = gradient(q, g);
+        const double h01 = k * s(q[0], 1) * s(q[1], 1);
+        if (follow_ && h01 != 0 && pattern_.nonZeros() == n_) pattern_ = pattern(true), ++version_;
+        H = pattern_;
+        for (int i = 0; i < n_; ++i) H.coeffRef(i, i) = 1;
+        H.coeffRef(0, 0) += k * s(q[0], 2) * s(q[1], 0), H.coeffRef(1, 1) += k * s(q[0], 0) * s(q[1], 2);
+        if (pattern_.nonZeros() > n_) H.coeffRef(0, 1) = h01;
+        return f;
+    }
+    const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
+    long pattern_version() const override { return follow_ ? version_ : 0; }
+
+private:
+    static constexpr double k = 40;
+    // s and its first two derivatives
+    static double s(double x, int d) {
+        const double u = std::max(0.0, x - 0.5);
+        return d == 0 ? u * u * u : d == 1 ? 3 * u * u : 6 * u;
+    }
+    Eigen::SparseMatrix<double> pattern(bool coupled) const {
+        std::vector<Eigen::Triplet<double>> t;
+        for (int i = 0; i < n_; ++i) t.emplace_back(i, i, 0.0);
+        if (coupled) t.emplace_back(0, 1, 0.0);
+        Eigen::SparseMatrix<double> P(n_, n_);
+        P.setFromTriplets(t.begin(), t.end());
+        P.makeCompressed();
+        return P;
+    }
+    int n_;
+    bool follow_;
+    long version_ = 1;
+    Eigen::SparseMatrix<double> pattern_;
+};
+}  // namespace
+
+TEST_CASE("newton: follows a Hessian pattern that changes during the solve", "[newton]") {
+    // From q = 0 the coupling comes into play on the way to the minimum: the first Hessian past 1/2 brings a new
+    // pattern, which Newton's factorizations analyze anew (LL^T, and the LDL^T rung). The solve ends at the same
+    // equilibrium as with the whole pattern fixed from the start.
+    for (const bool ldl : {false, true}) {
+        INFO("ldl " << ldl);
+        SolverOptions so;
+        so.tol = 1e-12, so.ldl = ldl;
+        NewtonSolver newton(so);
+        REQUIRE(newton.capabilities().follows_pattern);
+        Coupling followed(6, true), fixed(6, false);
+        Eigen::VectorXd q = Eigen::VectorXd::Zero(6), p = q;
+        const SolveResult r = newton.minimize(followed, q);
+        const SolveResult s = newton.minimize(fixed, p);
+        REQUIRE(r.converged());
+        REQUIRE(s.converged());
+        CHECK(followed.pattern_version() == 2);
+        CHECK(followed.hessian_pattern().nonZeros() == 7);
+        CHECK(q[0] < 0.99);  // the coupling acted
+        CHECK((q - p).lpNorm<Eigen::Infinity>() < 1e-10);
+    }
+}

@@ -2,11 +2,13 @@
 // central differences (crossings near nodes, at fiber ends, across the periodic box edge, in a sheared box, contacts of
 // aligned fibers, a tabulated law, fixed nodes) with the strain derivatives; beta = 0 bit for bit dry; the same on any
 // thread count; energy constant as a straight fiber slides along itself or across a crossing, and continuous along a
-// drag across nodes and off a fiber end; a bundle adheres with -beta per unit overlap.
+// drag across nodes and off a fiber end; a bundle adheres with -beta per unit overlap; a Hessian that follows the
+// pattern covers the pairs that came into range.
 #include <catch2/catch.hpp>
 #include <cmath>
 
 #include "../energy/fd.hpp"
+#include "fibernet/energy/sparse_pattern.hpp"
 #include "fibernet/util/parallel.hpp"
 #include "fibernet/wet/smooth_wet_energy.hpp"
 #include "wet_fixtures.hpp"
@@ -260,4 +262,56 @@ TEST_CASE("smooth wet energy: the partner cap bounds a stack's adhesion and leav
     CHECK(two == Approx(-10 * beta).epsilon(0.02));
     CHECK(SmoothWetEnergy(dry2, Eigen::Matrix2d::Identity(), smooth(beta, {}, 2), {}, q2).value(q2) ==
           Approx(two).epsilon(1e-12));
+}
+
+TEST_CASE("smooth wet energy: a Hessian that follows the pattern covers pairs that came into range",
+          "[wet][smooth]") {
+    // A stack of three fibers (in the partner cap's blend with a cap of 2), the third built a fiber length (10 seed
+    // units) above the others (beyond the pattern distance and the skin) and then moved onto them: its new pairs lie outside the pattern of the
+    // build. A fixed pattern leaves their blocks out and says so (pattern_stale); a followed one is rebuilt at the
+    // Hessian that needs it (pattern_version changes), which then equals that of an energy built at the new state.
+    const std::vector<Line> three = {{1.0, 1.5, 0, 1, 0.5}, {1.1, 1.505, 3, 1, 0.5}, {1.2, 2.51, -2, 1, 0.5}};
+    const Model m = model_of(network_of(three, 3));
+    NetworkEnergy dry(m);
+    const Eigen::VectorXd q0 = perturb(dry.dofs(m.x), 0.004, 61);
+    Eigen::VectorXd q1 = q0;
+    for (int n : m.chains[2].nodes)
+        if (dry.dof(n, 1) >= 0) q1[dry.dof(n, 1)] -= 10.0;
+    for (const int partners : {0, 2}) {
+        INFO("partners " << partners);
+        const SmoothWetParams p = smooth(2.5, {}, partners);
+        SmoothWetEnergy fresh(dry, Eigen::Matrix2d::Identity(), p, {}, q1);
+        REQUIRE(fresh.bridges(q1).size() > fresh.bridges(q0).size());
+        Eigen::VectorXd g1, g;
+        Eigen::SparseMatrix<double> H1 = fresh.hessian_pattern();
+        fresh.hessian(q1, g1, H1, false);
+        REQUIRE(!fresh.pattern_stale());
+        {  // fixed
+            SmoothWetEnergy W(dry, Eigen::Matrix2d::Identity(), p, {}, q0);
+            Eigen::SparseMatrix<double> H = W.hessian_pattern();
+            W.hessian(q1, g, H, false);
+            CHECK(W.pattern_version() == 0);
+            CHECK(W.pattern_stale());
+            CHECK((g - g1).lpNorm<Eigen::Infinity>() <= 1e-12 * (1 + g1.lpNorm<Eigen::Infinity>()));
+        }
+        SmoothWetEnergy W(dry, Eigen::Matrix2d::Identity(), p, {}, q0);
+        W.follow_pattern(true);
+        const long v0 = W.pattern_version();
+        CHECK(v0 != 0);
+        Eigen::SparseMatrix<double> H = W.hessian_pattern();
+        W.hessian(q1, g, H, false);
+        CHECK(W.pattern_version() != v0);
+        CHECK(!W.pattern_stale());
+        REQUIRE(same_pattern(H, W.hessian_pattern()));
+        REQUIRE(same_pattern(H, H1));
+        const double scale = 1 + Eigen::Map<const Eigen::VectorXd>(H1.valuePtr(), H1.nonZeros()).lpNorm<Eigen::Infinity>();
+        CHECK((Eigen::Map<const Eigen::VectorXd>(H.valuePtr(), H.nonZeros()) -
+               Eigen::Map<const Eigen::VectorXd>(H1.valuePtr(), H1.nonZeros()))
+                  .lpNorm<Eigen::Infinity>() <= 1e-12 * scale);
+        CHECK((g - g1).lpNorm<Eigen::Infinity>() <= 1e-12 * (1 + g1.lpNorm<Eigen::Infinity>()));
+        // At the same state again: the pattern stays.
+        const long v1 = W.pattern_version();
+        W.hessian(q1, g, H, false);
+        CHECK(W.pattern_version() == v1);
+    }
 }

@@ -18,10 +18,18 @@ public:
     virtual double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) = 0;
     // Value, gradient and Hessian. H must have hessian_pattern()'s pattern; its values are overwritten.
     // project_psd: per-element projection of the Hessian to positive semidefinite (a Newton safeguard).
+    // An objective whose pattern follows the state (pattern_version() != 0) may first replace its pattern by one that
+    // holds every non-zero element at q, and then gives H that pattern.
     virtual double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H,
                            bool project_psd) = 0;
-    // Upper-triangular CSC pattern, values zero; fixed for the lifetime of the objective.
+    // Upper-triangular CSC pattern, values zero; fixed for the lifetime of the objective, unless it follows the
+    // state (below).
     virtual const Eigen::SparseMatrix<double>& hessian_pattern() const = 0;
+    // 0: the pattern is fixed. Otherwise the pattern follows the state (the smooth wet energy, whose pairs come into
+    // range as fibers move): hessian() may replace it, and this number changes with every replacement, so that a
+    // solver that analyzed the old pattern (a sparse factorization's ordering, elimination's coupling graph) analyzes
+    // the new one. Only solvers with SolverCapabilities::follows_pattern are handed such an objective.
+    virtual long pattern_version() const { return 0; }
     // Optional, for nonlinear elimination (solve/nonlinear_elimination.hpp): the energy as a function of the
     // coordinates `coords` (sorted, distinct) alone, every other coordinate held where q has it. Its value may differ
     // from value() by a constant (the elements that touch no coordinate of the set are left out); its gradient and

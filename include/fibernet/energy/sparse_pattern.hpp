@@ -33,6 +33,9 @@ private:
     bool diagonal_ = false;
 };
 
+// Whether A and B have the same size and the same entries (compressed CSC; values ignored).
+bool same_pattern(const Eigen::SparseMatrix<double>& A, const Eigen::SparseMatrix<double>& B);
+
 // Index into P's values of entry (r, c), r <= c; throws std::logic_error if P lacks it.
 int pattern_slot(const Eigen::SparseMatrix<double>& P, int r, int c);
 

@@ -41,6 +41,7 @@ public:
     // Symbolic analysis of an upper-triangular CSC pattern (values ignored).
     void analyze(const Eigen::SparseMatrix<double>& upper) override;
     bool analyzed() const override;
+    void forget() override;
     // The analyzed order's independent row ranges [0, a) and [a, b) (factored at the same time); a = b = 0: none.
     int split_a() const;
     int split_b() const;

@@ -25,6 +25,7 @@ public:
     // Symbolic analysis of an upper-triangular CSC pattern (values ignored). Called once per model.
     void analyze(const Eigen::SparseMatrix<double>& upper) override;
     bool analyzed() const override;
+    void forget() override;
     // Numeric factorization of H + shift I (H: upper triangle with the analyzed pattern; a matrix of another size
     // or number of entries is analyzed first). False if not positive definite (or non-finite); the previous
     // factor is then unusable.

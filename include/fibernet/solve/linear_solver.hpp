@@ -21,6 +21,9 @@ public:
     // Symbolic analysis of an upper-triangular CSC pattern (values ignored).
     virtual void analyze(const Eigen::SparseMatrix<double>& upper) = 0;
     virtual bool analyzed() const = 0;
+    // Forgets the analysis: the next factorize() analyzes the matrix it is given (its pattern changed: a pattern that
+    // follows the state, Objective::pattern_version).
+    virtual void forget() = 0;
     // Numeric factorization of H + shift I (H with the analyzed pattern). False if it failed (for a definite() solver:
     // the matrix is not positive definite); the previous factor is then unusable.
     virtual bool factorize(const Eigen::SparseMatrix<double>& upper, double shift) = 0;

@@ -49,6 +49,9 @@ public:
     NonlinearElimination(const Eigen::SparseMatrix<double>& pattern, EliminationOptions opt, bool median_floor = false,
                          double max_step = 0);
 
+    // The coupling graph of a new pattern (the objective's changed: Objective::pattern_version).
+    void set_pattern(const Eigen::SparseMatrix<double>& pattern);
+
     // Picks the parts from the gradient g at the current state; false (no parts) when nothing is hot beyond the grown
     // set's size limit or max|g| is zero.
     bool select(const Eigen::VectorXd& g);

@@ -17,7 +17,8 @@ struct SolverOptions {
     double tol = 1e-10;      // stop at max|g| <= tol
     int max_iter = 500;      // iteration budget (solver-specific meaning: Newton steps, L-BFGS iterations, ...)
     double max_seconds = 0;  // wall-time budget, 0 = none
-    bool verbose = false;    // progress to stderr
+    bool verbose = false;    // progress to stderr (Newton: a line per iteration)
+    bool progress = false;   // the once-a-second progress line of verbose alone (solver_loop.hpp)
     bool warm_start = false; // start from the state the previous minimize() adapted (Newton: its shift), for a caller
                              // that resumes an interrupted solve of a slightly changed objective; others ignore it
     bool ldl = false;        // Newton: rung 0 by a simplicial LDL^T of the exact H + mu I with negative pivots flipped
@@ -50,6 +51,8 @@ struct SolverCapabilities {
     bool newton_steps = false;  // an iteration is a factorized Newton step, so a few of them make a round of the wet
                                 // active-set loop and its local rounds are solved with it (docs/wet.md, "Local rounds")
     bool shares_factorization = false;  // factorization_for() offers its analyzed positive definite factorization
+    bool follows_pattern = false;  // takes an objective whose Hessian pattern changes during a solve
+                                   // (Objective::pattern_version): analyzes each new pattern as it comes
 };
 
 class Solver {

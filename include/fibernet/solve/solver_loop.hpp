@@ -25,6 +25,7 @@ public:
     double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H,
                    bool psd) override;
     const Eigen::SparseMatrix<double>& hessian_pattern() const override { return f_.hessian_pattern(); }
+    long pattern_version() const override { return f_.pattern_version(); }
     std::unique_ptr<Objective> restriction(const Eigen::VectorXd& q, const std::vector<int>& coords) override {
         return f_.restriction(q, coords);  // not counted: the region's evaluations are its own solver's
     }

@@ -25,6 +25,7 @@ private:
     Eigen::VectorXd q_, g_;
     Eigen::SparseMatrix<double> H_, pattern_;
     std::vector<int> slot_;  // value index in f's pattern of each entry of pattern_
+    long version_ = 0;       // f's pattern_version() that slot_ indexes
 };
 
 }  // namespace fibernet

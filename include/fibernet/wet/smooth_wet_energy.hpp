@@ -11,7 +11,11 @@
 // of every *patterned* pair: those non-zero at the last rebuild() or closer than `pattern_distance` there. A Hessian
 // evaluated where a non-zero pair is not patterned leaves that pair's block out (value and gradient stay exact) and
 // sets pattern_stale(); the driver (relax_smooth_wet) then calls rebuild(). The pattern is fixed between rebuild()
-// calls, as a solver expects (objective.hpp).
+// calls, as a solver expects (objective.hpp). With follow_pattern(true), for a solver that follows a changing
+// pattern (SolverCapabilities::follows_pattern), a Hessian evaluated where a non-zero pair (or the partner cap's
+// coupling) is not patterned first rebuilds the pattern there, from the list in use, and gives H the new pattern;
+// it is then never stale, and pattern_version() counts the new patterns. The pattern rebuilt is a function of the
+// state alone (the pairs non-zero or within `pattern_distance`, which every valid list holds).
 //
 // Partner cap (SmoothWetParams::bundle_partners = N > 0, bundle_saturation.hpp): the contact parts of the pairs are
 // summed per segment and saturated there, so a pair's contact term enters with the weight (S'_a + S'_b) / 2 and a
@@ -63,6 +67,11 @@ public:
     double gradient(const Eigen::VectorXd& q, Eigen::VectorXd& g) override;
     double hessian(const Eigen::VectorXd& q, Eigen::VectorXd& g, Eigen::SparseMatrix<double>& H, bool project_psd) override;
     const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
+    // 0 while the pattern is fixed; with follow_pattern(true), 1 + the pattern builds so far.
+    long pattern_version() const override { return follow_ ? 1 + pattern_builds_ : 0; }
+    // Whether a Hessian rebuilds the pattern where it does not cover the state (above), instead of leaving the
+    // missing blocks out and setting pattern_stale().
+    void follow_pattern(bool on) { follow_ = on; }
     // The energy of the coordinates `coords` alone, at the cost of their elements (Objective::restriction; nonlinear
     // elimination): a SmoothWetRegion (smooth_wet_region.hpp), or the dry NetworkRegion at beta = 0.
     std::unique_ptr<Objective> restriction(const Eigen::VectorXd& q, const std::vector<int>& coords) override;
@@ -95,7 +104,14 @@ private:
     bool wet_crossing(const SegmentPair& p) const;
     // Indices of the listed pairs that are non-zero at x (in list order).
     std::vector<int> nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
-    void build_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B);
+    // The pattern at x from the list in use: `on` its non-zero pairs there, n the partner counts (with the cap).
+    void build_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on,
+                       const std::vector<double>& n);
+    // Follow mode: a pattern built at x unless it covers the non-zero pairs `on`, and H in it.
+    void cover(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on,
+               const std::vector<double>& n, Eigen::SparseMatrix<double>& H);
+    void new_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on,
+                     const std::vector<double>& n);
     void local_dofs(const SegmentPair& p, int idx[8]) const;
     // f(pair, its local coordinates) for every non-zero pair at q, in list order.
     void for_each_nonzero(const Eigen::VectorXd& q,
@@ -119,7 +135,7 @@ private:
                                 const std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>>& cgrad, double* hv);
     // The cap's extra pattern: per segment, the blocks between the segments of its aligned patterned partners.
     void add_partner_blocks(const std::vector<char>& take, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
-                            std::vector<int>& idx) const;
+                            const std::vector<double>& n, std::vector<int>& idx) const;
     // f(pair, its parts) for every non-zero pair at q, in list order.
     void for_each_part(const Eigen::VectorXd& q,
                        const std::function<void(const SegmentPair&, const CapillaryPairParts&)>& f) const;
@@ -148,7 +164,15 @@ private:
     std::vector<int> slots_;       // 64 per patterned pair (element_slots)
     size_t n_patterned_ = 0;
     bool stale_ = false;
+    bool follow_ = false;
+    bool retrying_ = false;  // eval() again in a pattern rebuilt for the cap's coupling
     EnergyEval eval_;
+    struct LastState {  // the non-zero pairs and the partner cap at the positions of the last evaluation
+        Eigen::VectorXd x;
+        int builds = -1;  // the list build they index
+        std::vector<int> on;
+        PartnerCap pc;
+    } at_;
     // Per-chunk pair results (eval), kept between evaluations.
     std::vector<double> chunk_E_;
     std::vector<Vector8d, Eigen::aligned_allocator<Vector8d>> chunk_g_;

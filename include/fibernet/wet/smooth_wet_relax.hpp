@@ -1,10 +1,14 @@
 #pragma once
 // Relaxing the smooth wet energy (smooth_wet_energy.hpp; issue 22): a solver minimizes the one energy directly. Its
-// values and gradients are always the whole energy's (the energy rebuilds its neighbour list where needed); between
-// rounds of at most `round_iterations` solver iterations the Hessian pattern is rebuilt where it no longer covers the
-// state (the list was rebuilt since, or a non-zero pair fell outside it). No bridge set, no events: a rebuild changes
-// only which pairs are evaluated and which entries the Hessian holds. Converged when the solver reports an
-// equilibrium, which then is one of the whole energy.
+// values and gradients are always the whole energy's (the energy rebuilds its neighbour list where needed). No bridge
+// set, no events: a rebuild changes only which pairs are evaluated and which entries the Hessian holds. Converged when
+// the solver reports an equilibrium, which then is one of the whole energy.
+//   - A solver that follows a changing Hessian pattern (SolverCapabilities::follows_pattern: Newton) minimizes it in
+//     one solve; the energy rebuilds the pattern at a Hessian that needs it (SmoothWetEnergy::follow_pattern), and
+//     the solver analyzes the new one. The budget is max_rounds x round_iterations iterations.
+//   - Any other solver runs rounds of at most `round_iterations` iterations (its own max_iter for solvers whose
+//     iterations are not Newton steps), the pattern fixed in each and rebuilt between them where it no longer covers
+//     the state (the list was rebuilt since, or a non-zero pair fell outside it).
 #include <Eigen/Core>
 #include <string>
 
@@ -18,18 +22,18 @@ struct SmoothRelaxOptions {
     // others get their own max_iter per round); 0: rounds are not cut.
     int round_iterations = 20;
     int max_rounds = 200;
-    bool progress = false;  // a line per round on stderr
+    bool progress = false;  // a line per round on stderr (following: the solver's once-a-second line)
     double max_step = -1;   // Newton: largest coordinate change per step (SolverOptions::max_step); < 0: the skin
     bool ldl = true;        // Newton's first rung by LDL^T with flipped negative pivots (SolverOptions::ldl), beta > 0
     bool projected = false; // projected Newton (SolverOptions::projected), beta > 0; takes precedence over ldl
-    bool always_rebuild = false;  // rebuild the list after every round, needed or not (tests: the same equilibrium)
+    bool follow_pattern = true;  // false: rounds for every solver (tests: the two ways agree)
 };
 
 struct SmoothRelaxResult {
     bool converged = false;
     std::string message;
-    SolveResult last;            // the last round's solve
-    int rounds = 0, list_builds = 0, pattern_builds = 0, stale_patterns = 0;
+    SolveResult last;            // the last round's solve (the one solve's, when it follows the pattern)
+    int rounds = 0, list_builds = 0, pattern_builds = 0, stale_patterns = 0;  // rounds = 1 when following
     int iterations = 0, factorizations = 0, evaluations = 0;
     int local_solves = 0, local_iterations = 0;  // nonlinear elimination's (SolverOptions::eliminate), summed
     double grad_max = 0;         // max|g| of the whole energy at the returned state
