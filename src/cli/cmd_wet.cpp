@@ -581,6 +581,7 @@ void register_wet(CLI::App& app) {
                                                                           {"local_solves", r.smooth.local_solves},
                                                                           {"local_iterations", r.smooth.local_iterations},
                                                                           {"seconds_patterns", r.smooth.seconds_patterns},
+                                                                          {"seconds_lists", r.smooth.seconds_lists},
                                                                           {"seconds_solver",
                                                                            {{"assembly", r.smooth.timings.assembly},
                                                                             {"factorization",

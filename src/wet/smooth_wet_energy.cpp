@@ -7,6 +7,7 @@
 
 #include "fibernet/energy/sparse_pattern.hpp"
 #include "fibernet/util/parallel.hpp"
+#include "fibernet/util/stopwatch.hpp"
 #include "fibernet/wet/bundle_saturation.hpp"
 #include "fibernet/wet/smooth_wet_region.hpp"
 
@@ -92,6 +93,7 @@ bool SmoothWetEnergy::beyond_support(const Vector8d& X) const {
 
 void SmoothWetEnergy::ensure_list(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const {
     if (list_.valid(x, B)) return;
+    ScopedSeconds timed(seconds_lists_);
     // A line search's trial left the list: rebuilt at the same place with a skin that reaches the trial, so that the
     // backtracking trials between the two stay covered (rebuilt at each of them, a 100-fiber run spent 85% of its
     // time building lists); a far trial (beyond 4 skins) gets a list of its own.
@@ -112,7 +114,10 @@ void SmoothWetEnergy::rebuild(const Eigen::VectorXd& q) {
     }
     const Eigen::VectorXd x = dry_.positions(q, F_);
     const Eigen::Matrix2d B = F_ * dry_.model().box.B0();
-    list_.build(x, B);
+    {
+        ScopedSeconds timed(seconds_lists_);
+        list_.build(x, B);
+    }
     wet_.resize(list_.pairs().size());
     for (size_t k = 0; k < wet_.size(); ++k) wet_[k] = wet_crossing(list_.pairs()[k]);
     const std::vector<int> on = nonzero_pairs(x, B);
@@ -121,6 +126,7 @@ void SmoothWetEnergy::rebuild(const Eigen::VectorXd& q) {
 
 void SmoothWetEnergy::new_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on,
                                   const std::vector<double>& n) {
+    ScopedSeconds timed(seconds_patterns_);
     build_pattern(x, B, on, n);
     stale_ = false;
     pattern_list_ = list_.builds();

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "fibernet/energy/sparse_pattern.hpp"
+#include "fibernet/util/stopwatch.hpp"
 #include "fibernet/wet/bundle_saturation.hpp"
 #include "fibernet/wet/smooth_wet_energy.hpp"
 
@@ -223,6 +224,7 @@ void SmoothWetRegion::place(const Eigen::VectorXd& qa) {
 double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) {
     place(qa);
     if (!W_.list_.valid_at(nodes_, x_, B_)) {  // the region left the list: W's list anew for its segments
+        ScopedSeconds timed(W_.seconds_lists_);
         W_.list_.update(x_, B_, segs_, nodes_);
         W_.index_list();
     }

@@ -82,11 +82,7 @@ void solve_in_rounds(SmoothWetEnergy& W, Solver& solver, Eigen::VectorXd& q, con
         const bool outdated = stale || !W.pattern_current();  // a reason the solve may have been held back
         if (stale) ++R.stale_patterns;
         const bool rebuilt = outdated && !R.last.converged();
-        if (rebuilt) {
-            const auto tl = Clock::now();
-            W.rebuild(q);
-            R.seconds_patterns += since(tl);
-        }
+        if (rebuilt) W.rebuild(q);
         if (opt.progress)
             std::fprintf(stderr, "  round %d: %s, %d iterations, E = %.10g, max|g| = %.3g%s\n", R.rounds,
                          to_string(R.last.status).c_str(), R.last.iterations, R.energy, R.grad_max,
@@ -111,12 +107,14 @@ SmoothRelaxResult relax_smooth_wet(SmoothWetEnergy& W, Solver& solver, Eigen::Ve
     const auto t0 = Clock::now();
     OptionsGuard guard(solver, W);
     const int lists0 = W.list_builds(), patterns0 = W.pattern_builds();
+    const double seconds_lists0 = W.seconds_lists(), seconds_patterns0 = W.seconds_patterns();
     SmoothRelaxResult R;
     if (W.params().pair.beta > 0 && solver.capabilities().follows_pattern && opt.follow_pattern)
         solve_following(W, solver, q, opt, guard.saved, R);
     else
         solve_in_rounds(W, solver, q, opt, guard.saved, R);
     R.list_builds = W.list_builds() - lists0, R.pattern_builds = W.pattern_builds() - patterns0;
+    R.seconds_lists = W.seconds_lists() - seconds_lists0, R.seconds_patterns = W.seconds_patterns() - seconds_patterns0;
     R.seconds = since(t0);
     return R;
 }

@@ -399,6 +399,14 @@ TEST_CASE("cli wet: the smooth model relaxes to an equilibrium of the whole ener
     REQUIRE(r["smooth"].is_object());
     CHECK(r["smooth"]["grad_max"].get<double>() <= 1e-9);
     CHECK(r["smooth"]["list_builds"].get<int>() >= 1);
+    // One Newton solve that followed the Hessian pattern; the time split names the list and pattern builds.
+    CHECK(r["smooth"]["rounds"] == 1);
+    CHECK(r["smooth"]["stale_patterns"] == 0);
+    const double total = r["smooth"]["seconds_solver"]["total"].get<double>();
+    CHECK(r["smooth"]["seconds_lists"].get<double>() >= 0);
+    CHECK(r["smooth"]["seconds_lists"].get<double>() <= total);
+    CHECK(r["smooth"]["seconds_patterns"].get<double>() >= 0);
+    CHECK(r["smooth"]["seconds_patterns"].get<double>() <= total);
     CHECK(r["energy"]["wet"]["capillary"].get<double>() < 0);
     CHECK(r["bridges"]["final"].get<int>() > 0);
     // The exact linear modulus of the smooth energy and the second difference of relaxed energies agree.

@@ -84,6 +84,10 @@ public:
     bool pattern_stale() const { return stale_; }
     int list_builds() const { return list_.builds(); }
     int pattern_builds() const { return pattern_builds_; }
+    // Seconds spent building and updating the list (with the list's indexes) and building patterns, so far (parts of
+    // the evaluations' time).
+    double seconds_lists() const { return seconds_lists_; }
+    double seconds_patterns() const { return seconds_patterns_; }
 
     void strain_derivatives(const Eigen::VectorXd& q, const Eigen::Matrix2d& dF, EnergyEval& out,
                             bool comoving = false) const override;
@@ -165,6 +169,7 @@ private:
     size_t n_patterned_ = 0;
     bool stale_ = false;
     bool follow_ = false;
+    mutable double seconds_lists_ = 0, seconds_patterns_ = 0;
     bool retrying_ = false;  // eval() again in a pattern rebuilt for the cap's coupling
     EnergyEval eval_;
     struct LastState {  // the non-zero pairs and the partner cap at the positions of the last evaluation

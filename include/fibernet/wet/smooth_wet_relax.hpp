@@ -39,7 +39,8 @@ struct SmoothRelaxResult {
     double grad_max = 0;         // max|g| of the whole energy at the returned state
     double energy = 0;
     SolveTimings timings;        // summed over the rounds
-    double seconds_patterns = 0; // pattern rebuilds between rounds (list rebuilds inside evaluations count as assembly)
+    double seconds_patterns = 0; // pattern builds (inside Newton's assembly when it follows the pattern)
+    double seconds_lists = 0;    // list builds and region updates (inside the evaluations' time)
     double seconds = 0;
 };
 

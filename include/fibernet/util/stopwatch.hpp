@@ -1,0 +1,20 @@
+#pragma once
+// Adds the wall time of a scope to a running total (the smooth wet energy's list and pattern builds, reported in the
+// time split of a wet run).
+#include <chrono>
+
+namespace fibernet {
+
+class ScopedSeconds {
+public:
+    explicit ScopedSeconds(double& total) : total_(total), t0_(std::chrono::steady_clock::now()) {}
+    ~ScopedSeconds() { total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
+    ScopedSeconds(const ScopedSeconds&) = delete;
+    ScopedSeconds& operator=(const ScopedSeconds&) = delete;
+
+private:
+    double& total_;
+    std::chrono::steady_clock::time_point t0_;
+};
+
+}  // namespace fibernet
