@@ -365,7 +365,12 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
     std::vector<LinearSolver*> lins{&llt};
     if (opt_.ldl && ldl_) lins.push_back(ldl_.get());
     Newton method(opt_, ladder, ladder.modified_ldl(), trace_.shift_rel, trace_, lins);
-    return run_iterations(run, method, q);
+    const long version = f.pattern_version();
+    SolveResult r = run_iterations(run, method, q);
+    // The pattern changed during the solve: the factorizations were analyzed anew for patterns analyzed_ does not
+    // name, so the next solve or factorization_for() analyzes afresh.
+    if (f.pattern_version() != version) llt_.reset(), ldl_.reset(), analyzed_ = Eigen::SparseMatrix<double>();
+    return r;
 }
 
 }  // namespace fibernet

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <climits>
+#include <cstdint>
 #include <cstdio>
 
 namespace fibernet {
@@ -54,8 +55,8 @@ void solve_following(SmoothWetEnergy& W, Solver& solver, Eigen::VectorXd& q, con
                      const SolverOptions& base, SmoothRelaxResult& R) {
     SolverOptions& o = solver.options();
     configure(o, base, solver.capabilities(), W, opt);
-    const long per_round = opt.round_iterations > 0 ? opt.round_iterations : base.max_iter;
-    o.max_iter = static_cast<int>(std::min<long>(INT_MAX, per_round * opt.max_rounds));
+    const std::int64_t per_round = opt.round_iterations > 0 ? opt.round_iterations : base.max_iter;
+    o.max_iter = static_cast<int>(std::min<std::int64_t>(INT_MAX, per_round * opt.max_rounds));
     o.progress = base.progress || opt.progress;
     W.follow_pattern(true);
     add(R, solver.minimize(W, q));

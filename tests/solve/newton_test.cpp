@@ -563,7 +563,8 @@ private:
 TEST_CASE("newton: follows a Hessian pattern that changes during the solve", "[newton]") {
     // From q = 0 the coupling comes into play on the way to the minimum: the first Hessian past 1/2 brings a new
     // pattern, which Newton's factorizations analyze anew (LL^T, and the LDL^T rung). The solve ends at the same
-    // equilibrium as with the whole pattern fixed from the start.
+    // equilibrium as with the whole pattern fixed from the start. The same solver then solves a fresh objective, whose
+    // first pattern is the one the last solve started with (not the one it ended with).
     for (const bool ldl : {false, true}) {
         INFO("ldl " << ldl);
         SolverOptions so;
@@ -573,7 +574,12 @@ TEST_CASE("newton: follows a Hessian pattern that changes during the solve", "[n
         Coupling followed(6, true), fixed(6, false);
         Eigen::VectorXd q = Eigen::VectorXd::Zero(6), p = q;
         const SolveResult r = newton.minimize(followed, q);
+        Coupling again(6, true);
+        Eigen::VectorXd q2 = Eigen::VectorXd::Zero(6);
+        const SolveResult r2 = newton.minimize(again, q2);
         const SolveResult s = newton.minimize(fixed, p);
+        REQUIRE(r2.converged());
+        CHECK((q2 - q).lpNorm<Eigen::Infinity>() < 1e-10);
         REQUIRE(r.converged());
         REQUIRE(s.converged());
         CHECK(followed.pattern_version() == 2);
