@@ -73,21 +73,30 @@ std::uint64_t SmoothWetEnergy::key(const SegmentPair& p) {
            (static_cast<std::uint64_t>(p.image.x() + 128) << 8) | static_cast<std::uint64_t>(p.image.y() + 128);
 }
 
+void SmoothWetEnergy::index_wet() const {
+    const std::vector<SegmentPair>& P = list_.pairs();
+    wet_.resize(P.size());
+    for (size_t k = 0; k < P.size(); ++k) wet_[k] = wet_crossing(P[k]);
+}
+
 void SmoothWetEnergy::index_list() const {
     const std::vector<SegmentPair>& P = list_.pairs();
     patterned_.assign(P.size(), -1);
-    wet_.resize(P.size());
     for (size_t k = 0; k < P.size(); ++k) {
         const auto it = pattern_index_.find(key(P[k]));
         if (it != pattern_index_.end()) patterned_[k] = it->second;
-        wet_[k] = wet_crossing(P[k]);
     }
+    index_wet();
+}
+
+double SmoothWetEnergy::support_distance(double L) const {
+    return std::max(support_crossing_, support_contact_ + support_slope_ * L);
 }
 
 bool SmoothWetEnergy::beyond_support(const Vector8d& X) const {
     const double L = std::sqrt(std::max((X.segment<2>(2) - X.segment<2>(0)).squaredNorm(),
                                         (X.segment<2>(6) - X.segment<2>(4)).squaredNorm()));
-    const double support = std::max(support_crossing_, support_contact_ + support_slope_ * L);
+    const double support = support_distance(L);
     return box_gap_squared(X) > support * support;
 }
 
@@ -118,8 +127,7 @@ void SmoothWetEnergy::rebuild(const Eigen::VectorXd& q) {
         ScopedSeconds timed(seconds_lists_);
         list_.build(x, B);
     }
-    wet_.resize(list_.pairs().size());
-    for (size_t k = 0; k < wet_.size(); ++k) wet_[k] = wet_crossing(list_.pairs()[k]);
+    index_wet();
     const std::vector<int> on = nonzero_pairs(x, B);
     new_pattern(x, B, on, capped() ? partner_cap(x, B, on).n : std::vector<double>{});
 }
@@ -164,8 +172,7 @@ std::vector<int> SmoothWetEnergy::nonzero_pairs(const Eigen::VectorXd& x, const 
             const Eigen::Vector2d t = B * P[k].image.cast<double>();
             const double gx = std::max({0.0, b.x0 + t.x() - a.x1, a.x0 - b.x1 - t.x()});
             const double gy = std::max({0.0, b.y0 + t.y() - a.y1, a.y0 - b.y1 - t.y()});
-            const double support =
-                std::max(support_crossing_, support_contact_ + support_slope_ * std::max(a.length, b.length));
+            const double support = support_distance(std::max(a.length, b.length));
             if (gx * gx + gy * gy > support * support) continue;
             on[k] = !capillary_pair_vanishes(list_.coordinates(P[k], x, B), wet_[k], params_.pair);
         }

@@ -145,8 +145,11 @@ private:
                        const std::function<void(const SegmentPair&, const CapillaryPairParts&)>& f) const;
     // Rebuilds the list if it is not valid at x (and indexes it: index_list).
     void ensure_list(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
-    // Per listed pair: its patterned index and whether its crossing is wet.
+    // Per listed pair: its patterned index and whether its crossing is wet (index_wet: the latter alone).
     void index_list() const;
+    void index_wet() const;
+    // Beyond this distance a pair of segments whose longer one has length L is exactly zero.
+    double support_distance(double L) const;
     // Whether the pair at X is surely zero from its segments' bounding boxes alone (farther apart than the support).
     bool beyond_support(const Vector8d& X) const;
     static std::uint64_t key(const SegmentPair& p);
