@@ -33,7 +33,8 @@ Jet<N> apply(const Jet<N>& a, double f, double df, double d2f) {
     Jet<N> r;
     r.v = f;
     r.g = df * a.g;
-    r.h = df * a.h + d2f * a.g * a.g.transpose();
+    r.h = df * a.h;
+    r.h.noalias() += (d2f * a.g) * a.g.transpose();  // no temporary (operator* below)
     return r;
 }
 
@@ -60,7 +61,11 @@ Jet<N> operator*(const Jet<N>& a, const Jet<N>& b) {
     Jet<N> r;
     r.v = a.v * b.v;
     r.g = a.v * b.g + b.v * a.g;
-    r.h = a.v * b.h + b.v * a.h + a.g * b.g.transpose() + b.g * a.g.transpose();
+    // In three statements, so that no temporary holds the outer products; each entry sums in the order of the one
+    // expression ((a.v b.h + b.v a.h) + a.g b.g^T) + b.g a.g^T, so the result is the same (products commute exactly).
+    r.h = a.v * b.h + b.v * a.h;
+    r.h.noalias() += a.g * b.g.transpose();
+    r.h.noalias() += b.g * a.g.transpose();
     return r;
 }
 template <int N>
