@@ -23,6 +23,7 @@ nlohmann::json solve_json(const SolveResult& r, double tol) {
             {"local_solves", r.local_solves},
             {"local_iterations", r.local_iterations},
             {"local_factorizations", r.local_factorizations},
+            {"eliminating_iterations", r.eliminating_iterations},
             {"grad_max", r.grad_max},
             {"grad_floor_bound", r.grad_floor},
             {"tol", tol},

@@ -580,6 +580,8 @@ void register_wet(CLI::App& app) {
                                                                           {"factorizations", r.smooth.factorizations},
                                                                           {"local_solves", r.smooth.local_solves},
                                                                           {"local_iterations", r.smooth.local_iterations},
+                                                                          {"eliminating_iterations",
+                                                                           r.smooth.eliminating_iterations},
                                                                           {"seconds_patterns", r.smooth.seconds_patterns},
                                                                           {"seconds_lists", r.smooth.seconds_lists},
                                                                           {"seconds_solver",

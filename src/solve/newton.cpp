@@ -131,7 +131,7 @@ public:
         if (ne_) {
             const EliminationCounts& c = ne_->counts();
             r.local_solves = c.local_solves, r.local_iterations = c.local_iterations;
-            r.local_factorizations = c.local_factorizations;
+            r.local_factorizations = c.local_factorizations, r.eliminating_iterations = c.selections;
         }
         if (mu_lm_ > 0 && dm_last_ > 0) trace_.shift_rel = mu_lm_ / dm_last_;
     }

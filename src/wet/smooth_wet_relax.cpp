@@ -38,6 +38,7 @@ void add(SmoothRelaxResult& R, const SolveResult& s) {
     R.last = s;
     R.iterations += s.iterations, R.factorizations += s.factorizations, R.evaluations += s.evaluations;
     R.local_solves += s.local_solves, R.local_iterations += s.local_iterations;
+    R.eliminating_iterations += s.eliminating_iterations;
     R.timings += s.timings;
     R.energy = s.energy, R.grad_max = s.grad_max;
 }

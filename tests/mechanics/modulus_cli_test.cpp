@@ -176,12 +176,15 @@ TEST_CASE("cli relax: elimination by default, the same equilibrium stress as --n
     REQUIRE(run(scene + " --no-eliminate") == 0);
     const auto plain = out();
     CHECK(plain["solver"]["local_solves"].get<int>() == 0);
+    CHECK(plain["solver"]["eliminating_iterations"].get<int>() == 0);
     CHECK(plain["provenance"]["scene_toml"].get<std::string>().find("eliminate = false") != std::string::npos);
     REQUIRE(run(scene) == 0);
     const auto el = out();
     CHECK(el["status"] == "converged");
     CHECK(el["solver"]["grad_max"].get<double>() <= 1e-9);
     CHECK(el["solver"]["local_solves"].get<int>() > 0);
+    CHECK(el["solver"]["eliminating_iterations"].get<int>() > 0);
+    CHECK(el["solver"]["eliminating_iterations"].get<int>() <= el["solver"]["iterations"].get<int>());
     CHECK(el["solver"]["factorizations"].get<int>() < plain["solver"]["factorizations"].get<int>());
     // Both at max|g| <= 1e-9: the stress of one minimum agrees far beyond 1e-9 relative.
     const double s0 = plain["stress"]["xy"].get<double>(), s1 = el["stress"]["xy"].get<double>();

@@ -93,6 +93,8 @@ TEST_CASE("Newton with elimination returns plain Newton's equilibrium of the who
         const SolveResult r = solve(rec, q, true);
         REQUIRE(r.converged());
         CHECK(r.local_solves > 0);  // the network has hot places: elimination ran
+        CHECK(r.eliminating_iterations > 0);
+        CHECK(r.eliminating_iterations <= r.iterations);
         CHECK(rec.restrictions == r.local_solves);
         // The whole gradient, recomputed here, not the solver's word.
         Eigen::VectorXd g;

@@ -428,6 +428,8 @@ TEST_CASE("cli wet: the smooth model with nonlinear elimination reaches an equil
     CHECK(r["status"] == "stable");
     CHECK(r["smooth"]["grad_max"].get<double>() <= 1e-9);
     CHECK(r["smooth"]["local_solves"].get<int>() > 0);
+    CHECK(r["smooth"]["eliminating_iterations"].get<int>() > 0);
+    CHECK(r["smooth"]["eliminating_iterations"].get<int>() <= r["smooth"]["factorizations"].get<int>());
     CHECK(r["energy"]["wet"]["capillary"].get<double>() < 0);
 }
 

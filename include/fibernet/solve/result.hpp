@@ -35,6 +35,8 @@ struct SolveResult {
     int local_solves = 0;               // Newton with elimination: part solves, their iterations and factorizations
     int local_iterations = 0;           // (not counted in iterations and factorizations above, which are global)
     int local_factorizations = 0;
+    int eliminating_iterations = 0;     // Newton with elimination: global iterations that solved hot parts first (the
+                                        // others found none, or a grown set above EliminationOptions::max_fraction)
     double energy = 0;
     double grad_max = 0;                // max |g| at the returned state
     double grad_floor = 0;              // round-off floor of max |g| at the returned state (Newton; 0: not estimated)

@@ -36,6 +36,7 @@ struct SmoothRelaxResult {
     int rounds = 0, list_builds = 0, pattern_builds = 0, stale_patterns = 0;  // rounds = 1 when following
     int iterations = 0, factorizations = 0, evaluations = 0;
     int local_solves = 0, local_iterations = 0;  // nonlinear elimination's (SolverOptions::eliminate), summed
+    int eliminating_iterations = 0;              // global iterations that eliminated (SolveResult), summed
     double grad_max = 0;         // max|g| of the whole energy at the returned state
     double energy = 0;
     SolveTimings timings;        // summed over the rounds
