@@ -34,7 +34,7 @@ Jet<N> apply(const Jet<N>& a, double f, double df, double d2f) {
     r.v = f;
     r.g = df * a.g;
     r.h = df * a.h;
-    r.h.noalias() += (d2f * a.g) * a.g.transpose();  // no temporary (operator* below)
+    r.h.noalias() += (d2f * a.g) * a.g.transpose();  // in place, as in operator* below
     return r;
 }
 
