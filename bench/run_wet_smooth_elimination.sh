@@ -8,7 +8,8 @@
 #   bench/run_wet_smooth_elimination.sh > rows.tsv
 # Environment: FIBERNET (default build/fibernet), CASES ("L Q SEED BETA" per case, ';'-separated; default 100, 300 and
 # 1000 fibers at beta = 0.01 and the 128-fiber beta = 1 example), METHODS ("plain eliminate"), FLAGS (extra flags of
-# every run, e.g. "--wet-eliminate-hops 4").
+# every run, e.g. "--wet-eliminate-hops 4"), KEEP (a directory: each run's JSON and its -v progress log are kept there as
+# N-BETA-METHOD.json and .log, for the time split in the JSON's smooth.seconds_solver and a long run's progress).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 exe=${FIBERNET:-$root/build/fibernet}
@@ -25,9 +26,18 @@ for c in "${case_list[@]}"; do
         flags=()
         [ "$method" = eliminate ] && flags=(--wet-eliminate)
         rc=0
+        log=/dev/null
+        talk=-q
+        if [ -n "${KEEP:-}" ]; then
+            mkdir -p "$KEEP"
+            tag=$(/usr/bin/python3 -c "print(round($Q * $L * $L))")-$BETA-$method
+            log=$KEEP/$tag.log
+            talk=-v
+        fi
         # shellcheck disable=SC2086
         "$exe" wet --network "$work/w.net" --betas "$BETA" --no-moduli --wet-model smooth --bundle-partners 2 \
-            -o "$work/$method" -q ${FLAGS:-} "${flags[@]}" > "$work/$method.json" || rc=$?
+            -o "$work/$method" $talk ${FLAGS:-} "${flags[@]}" > "$work/$method.json" 2> "$log" || rc=$?
+        [ -n "${KEEP:-}" ] && cp "$work/$method.json" "$KEEP/$tag.json"
         /usr/bin/python3 - "$work/$method.json" "$method" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))

@@ -98,10 +98,12 @@ bool add_outer_product(const Eigen::SparseMatrix<double>& P, std::vector<std::pa
     return complete;
 }
 
-void element_slots(const Eigen::SparseMatrix<double>& P, const std::vector<int>& idx, int M, std::vector<int>& out) {
+void element_slots(const Eigen::SparseMatrix<double>& P, const std::vector<int>& idx, int M, std::vector<int>& out,
+                   std::vector<char>* lacking) {
     const int n = static_cast<int>(P.cols());
     const size_t ne = idx.size() / M;
     out.assign(ne * M * M, -1);
+    if (lacking) lacking->assign(ne, 0);
     // The (element, b) pairs of each column, by counting sort.
     std::vector<int> start(n + 1, 0);
     for (int c : idx)
@@ -125,7 +127,11 @@ void element_slots(const Eigen::SparseMatrix<double>& P, const std::vector<int>&
             for (int a = 0; a < M; ++a) {
                 const int r = idx[e * M + a];
                 if (r < 0 || r > c) continue;
-                if (pos[r] < 0) throw std::logic_error("hessian pattern lacks an entry");
+                if (pos[r] < 0) {
+                    if (!lacking) throw std::logic_error("hessian pattern lacks an entry");
+                    (*lacking)[e] = 1;
+                    continue;
+                }
                 out[e * M * M + a * M + b] = pos[r];
             }
         }

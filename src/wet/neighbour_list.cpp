@@ -239,6 +239,8 @@ void NeighbourList::build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, do
     x_built_ = x;
     B_built_ = B;
     cache_ = std::make_shared<Cache>(Cache{fr, std::move(grid), std::move(seg)});
+    origin_.clear();
+    origin_build_ = -1;
     ++builds_;
 }
 
@@ -298,12 +300,23 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
     }
     std::sort(found.begin(), found.end(), pair_less);
     found.erase(std::unique(found.begin(), found.end(), pair_equal), found.end());
-    pairs_.erase(std::remove_if(pairs_.begin(), pairs_.end(), [&](const SegmentPair& p) { return in[p.a] || in[p.b]; }),
-                 pairs_.end());
+    // The kept pairs (no segment of `segments`) and the found ones, merged in list order; each pair remembers its
+    // index before the update (origin(), -1 if found), so that callers re-index only the found ones. The two sets are
+    // disjoint, so the order is std::merge's.
     std::vector<SegmentPair> merged;
-    merged.reserve(pairs_.size() + found.size());
-    std::merge(pairs_.begin(), pairs_.end(), found.begin(), found.end(), std::back_inserter(merged), pair_less);
+    std::vector<int> origin;
+    merged.reserve(pairs_.size() + found.size()), origin.reserve(pairs_.size() + found.size());
+    size_t j = 0;
+    for (size_t k = 0; k < pairs_.size(); ++k) {
+        const SegmentPair& p = pairs_[k];
+        if (in[p.a] || in[p.b]) continue;
+        for (; j < found.size() && pair_less(found[j], p); ++j) merged.push_back(found[j]), origin.push_back(-1);
+        merged.push_back(p), origin.push_back(static_cast<int>(k));
+    }
+    for (; j < found.size(); ++j) merged.push_back(found[j]), origin.push_back(-1);
     pairs_.swap(merged);
+    origin_.swap(origin);
+    origin_build_ = builds_;
     for (int v : nodes) x_built_.segment<2>(2 * v) = x.segment<2>(2 * v);
     ++builds_;
 }

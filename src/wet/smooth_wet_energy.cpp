@@ -81,12 +81,28 @@ void SmoothWetEnergy::index_wet() const {
 
 void SmoothWetEnergy::index_list() const {
     const std::vector<SegmentPair>& P = list_.pairs();
-    patterned_.assign(P.size(), -1);
-    for (size_t k = 0; k < P.size(); ++k) {
-        const auto it = pattern_index_.find(key(P[k]));
-        if (it != pattern_index_.end()) patterned_[k] = it->second;
+    auto patterned = [&](const SegmentPair& p) {
+        const auto it = pattern_index_.find(key(p));
+        return it != pattern_index_.end() ? it->second : -1;
+    };
+    const std::vector<int>& from = list_.origin();
+    if (list_.origin_build() >= 0 && list_.origin_build() == indexed_build_ && from.size() == P.size()) {
+        // An update of the list indexed last (a region's local solve): the kept pairs carry their indices over, only
+        // the pairs found anew are looked up. A hash lookup per listed pair made this O(list) per local solve.
+        std::vector<int> pat(P.size());
+        std::vector<char> wet(P.size());
+        for (size_t k = 0; k < P.size(); ++k) {
+            const int o = from[k];
+            pat[k] = o >= 0 ? patterned_[o] : patterned(P[k]);
+            wet[k] = o >= 0 ? wet_[o] : static_cast<char>(wet_crossing(P[k]));
+        }
+        patterned_.swap(pat), wet_.swap(wet);
+    } else {
+        patterned_.resize(P.size());
+        for (size_t k = 0; k < P.size(); ++k) patterned_[k] = patterned(P[k]);
+        index_wet();
     }
-    index_wet();
+    indexed_build_ = list_.builds();
 }
 
 double SmoothWetEnergy::support_distance(double L) const {
@@ -130,6 +146,7 @@ void SmoothWetEnergy::rebuild(const Eigen::VectorXd& q) {
     index_wet();
     const std::vector<int> on = nonzero_pairs(x, B);
     new_pattern(x, B, on, capped() ? partner_cap(x, B, on).n : std::vector<double>{});
+    indexed_build_ = list_.builds();  // wet_ and patterned_ index this build
 }
 
 void SmoothWetEnergy::new_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on,

@@ -87,19 +87,8 @@ SmoothWetRegion::SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, co
 }
 
 void SmoothWetRegion::slot_pairs() {
-    // Per pair the slots of its upper block in the pattern (element_slots' layout), -1 where the pattern lacks one.
-    slots_.assign(64 * pairs_.size(), -1);
-    unpatterned_.assign(pairs_.size(), 0);
-    for (size_t i = 0; i < pairs_.size(); ++i) {
-        const int* idx = &idx_[8 * i];
-        for (int a = 0; a < 8; ++a)
-            for (int b = 0; b < 8; ++b) {
-                if (idx[a] < 0 || idx[b] < 0 || idx[a] > idx[b]) continue;
-                const int sl = find_slot(pattern_, idx[a], idx[b]);
-                slots_[64 * i + 8 * a + b] = sl;
-                if (sl < 0) unpatterned_[i] = 1;
-            }
-    }
+    // Per pair the slots of its upper block in the pattern, -1 where the pattern lacks one (the pair is unpatterned).
+    element_slots(pattern_, idx_, 8, slots_, &unpatterned_);
 }
 
 void SmoothWetRegion::take_pairs() {

@@ -78,6 +78,12 @@ TEST_CASE("sparse pattern: columns sorted and deduplicated; element_slots equals
     for (int c = 0; c < n; ++c) diag.insert(c, c) = 0;
     diag.makeCompressed();
     CHECK_THROWS_AS(element_slots(diag, bad, 2, slots), std::logic_error);
+    // ... unless the caller takes the lacking elements: their missing entries are -1, the others as found.
+    std::vector<int> some = {0, n - 1, 1, 1, 2, -1};  // (0, n-1) lacks its off-diagonal entry; the others have theirs
+    std::vector<char> lacking;
+    element_slots(diag, some, 2, slots, &lacking);
+    CHECK(lacking == std::vector<char>{1, 0, 0});
+    CHECK(slots == std::vector<int>{0, -1, -1, n - 1, 1, 1, 1, 1, 2, -1, -1, -1});
     CHECK_THROWS_AS(pattern_slot(diag, 0, n - 1), std::logic_error);
     CHECK_THROWS_AS(subpattern_slots(diag, P), std::logic_error);
 }

@@ -94,8 +94,32 @@ TEST_CASE("neighbour list: every pair within range, built and updated", "[wet][n
     const int before = missing(list, m, x2, B);
     CHECK(before > 0);  // the move brought pairs into range that the list lacks
     const int builds = list.builds();
+    CHECK(list.origin_build() == -1);  // built, not updated
+    const std::vector<SegmentPair> old_pairs = list.pairs();
     list.update(x2, B, segs, nodes);
     CHECK(list.builds() == builds + 1);
+    // Each pair's origin: its index in the list before the update (the same pair), or -1 for one found anew, which
+    // holds a segment of the region.
+    REQUIRE(list.origin_build() == builds);
+    REQUIRE(list.origin().size() == list.pairs().size());
+    std::vector<char> in_segs(m.segments.size(), 0);
+    for (int s : segs) in_segs[s] = 1;
+    int kept = 0, found = 0, wrong = 0;
+    for (size_t k = 0; k < list.pairs().size(); ++k) {
+        const SegmentPair& p = list.pairs()[k];
+        const int o = list.origin()[k];
+        if (o < 0) {
+            ++found;
+            wrong += !(in_segs[p.a] || in_segs[p.b]);
+            continue;
+        }
+        ++kept;
+        const SegmentPair& q = old_pairs[static_cast<size_t>(o)];
+        wrong += q.a != p.a || q.b != p.b || q.image != p.image || in_segs[p.a] || in_segs[p.b];
+    }
+    CHECK(wrong == 0);
+    CHECK(kept > 0);
+    CHECK(found > 0);
     CHECK(list.valid(x2, B));
     CHECK(missing(list, m, x2, B) == 0);
     // Then every node within half the skin of where it was last built (the region's nodes of x2, the others of x):

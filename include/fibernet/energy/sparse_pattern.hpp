@@ -50,8 +50,10 @@ bool add_outer_product(const Eigen::SparseMatrix<double>& P, std::vector<std::pa
 // Value slots of many elements at once, each with M local coordinates: idx[e M + a] is local coordinate a's row/column
 // in P (-1: none). out (resized to elements x M x M) gets at e M M + a M + b the slot of (idx[e M + a], idx[e M + b])
 // if both exist and the first <= the second, else -1. The same as pattern_slot entry by entry, in time linear in the
-// entries (one pass per column, no search): a 1e4-fiber wet Hessian has ~6e6 of them. Throws like pattern_slot.
-void element_slots(const Eigen::SparseMatrix<double>& P, const std::vector<int>& idx, int M, std::vector<int>& out);
+// entries (one pass per column, no search): a 1e4-fiber wet Hessian has ~6e6 of them. Throws like pattern_slot, or,
+// given `lacking` (resized to elements), leaves a missing entry at -1 and marks its element there.
+void element_slots(const Eigen::SparseMatrix<double>& P, const std::vector<int>& idx, int M, std::vector<int>& out,
+                   std::vector<char>* lacking = nullptr);
 
 // The slot in P of every entry of a pattern S contained in P, in S's value order (one pass per column). Throws like
 // pattern_slot if P lacks one.

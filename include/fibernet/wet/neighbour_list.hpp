@@ -49,6 +49,10 @@ public:
     bool valid_at(const std::vector<int>& nodes, const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
     const std::vector<SegmentPair>& pairs() const { return pairs_; }
     int builds() const { return builds_; }
+    // When the list was last changed by update(): the build it was updated from (builds() - 1), and per pair its index
+    // in that build's list, or -1 for a pair found anew. After a full build: -1 and no origins.
+    int origin_build() const { return origin_build_; }
+    const std::vector<int>& origin() const { return origin_; }
     double skin() const { return skin_; }
 
     // Local coordinates (p0, p1, q0, q1) of pair k at positions x in box B.
@@ -65,6 +69,8 @@ private:
     Eigen::VectorXd x_built_;
     Eigen::Matrix2d B_built_ = Eigen::Matrix2d::Zero();
     int builds_ = 0;
+    int origin_build_ = -1;
+    std::vector<int> origin_;
     struct Cache;
     std::shared_ptr<Cache> cache_;  // the last full build's grid, for update()
 };

@@ -165,6 +165,7 @@ private:
     std::vector<int> dry_slot_;
     mutable std::vector<int> patterned_;  // per listed pair: its index among the patterned pairs, or -1
     mutable std::vector<char> wet_;       // per listed pair: wet_crossing()
+    mutable int indexed_build_ = -1;      // the list build that index_list() gave patterned_ and wet_ for
     double support_crossing_ = 0, support_contact_ = 0, support_slope_ = 0;  // support_distance(L) = max(c, c0 + s L)
     std::unordered_map<std::uint64_t, int> pattern_index_;  // patterned pair (key()) -> its index
     int pattern_list_ = 0, pattern_builds_ = 0;
