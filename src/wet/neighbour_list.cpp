@@ -303,8 +303,9 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
     // The kept pairs (no segment of `segments`) and the found ones, merged in list order; each pair remembers its
     // index before the update (origin(), -1 if found), so that callers re-index only the found ones. The two sets are
     // disjoint, so the order is std::merge's.
-    std::vector<SegmentPair> merged;
-    std::vector<int> origin;
+    std::vector<SegmentPair>& merged = merged_;
+    std::vector<int>& origin = origin_next_;
+    merged.clear(), origin.clear();
     merged.reserve(pairs_.size() + found.size()), origin.reserve(pairs_.size() + found.size());
     size_t j = 0;
     for (size_t k = 0; k < pairs_.size(); ++k) {

@@ -89,8 +89,9 @@ void SmoothWetEnergy::index_list() const {
     if (list_.origin_build() >= 0 && list_.origin_build() == indexed_build_ && from.size() == P.size()) {
         // An update of the list indexed last (a region's local solve): the kept pairs carry their indices over, only
         // the pairs found anew are looked up. A hash lookup per listed pair made this O(list) per local solve.
-        std::vector<int> pat(P.size());
-        std::vector<char> wet(P.size());
+        std::vector<int>& pat = patterned_next_;
+        std::vector<char>& wet = wet_next_;
+        pat.resize(P.size()), wet.resize(P.size());
         for (size_t k = 0; k < P.size(); ++k) {
             const int o = from[k];
             pat[k] = o >= 0 ? patterned_[o] : patterned(P[k]);

@@ -71,6 +71,8 @@ private:
     int builds_ = 0;
     int origin_build_ = -1;
     std::vector<int> origin_;
+    std::vector<SegmentPair> merged_;  // update()'s buffers (swapped with pairs_ and origin_), kept between updates
+    std::vector<int> origin_next_;
     struct Cache;
     std::shared_ptr<Cache> cache_;  // the last full build's grid, for update()
 };
