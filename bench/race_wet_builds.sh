@@ -15,7 +15,8 @@ base=$1 new=$2 secs=$3
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 # shellcheck disable=SC2086
-"$new" generate ${NETWORK:---L 31.623 --q 10 --pl 0.5 --seed 1} -o "$work/w.net" >/dev/null
+"$new" generate ${NETWORK:---L 31.623 --q 10 --pl 0.5 --seed 1} -o "$work/w.net" >/dev/null 2>&1 ||
+    { echo "$0: generate failed: ${NETWORK:-}" >&2; exit 2; }
 export FIBERNET_THREADS=1 OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 for b in base new; do
     exe=$base
