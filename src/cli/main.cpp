@@ -7,11 +7,13 @@
 #include "common.hpp"
 #include "in_process.hpp"
 #include "fibernet_version.hpp"
+#include "fibernet/util/allocator.hpp"
 #include "fibernet/util/error.hpp"
 #include "fibernet/util/parallel.hpp"
 
 int main(int argc, char** argv) {
     using namespace fibernet;
+    keep_freed_memory();
     CLI::App app{"fibernet: mechanics of random fiber networks by implicit energy minimization", "fibernet"};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("fibernet ") + FIBERNET_VERSION + " (" + FIBERNET_GIT_COMMIT + ")");
