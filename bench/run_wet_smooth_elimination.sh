@@ -26,7 +26,7 @@ for c in "${case_list[@]}"; do
         flags=()
         [ "$method" = eliminate ] && flags=(--wet-eliminate)
         rc=0
-        log=/dev/null
+        log=/dev/stderr  # errors stay visible; -q keeps progress off
         talk=-q
         if [ -n "${KEEP:-}" ]; then
             mkdir -p "$KEEP"
@@ -37,7 +37,7 @@ for c in "${case_list[@]}"; do
         # shellcheck disable=SC2086
         "$exe" wet --network "$work/w.net" --betas "$BETA" --no-moduli --wet-model smooth --bundle-partners 2 \
             -o "$work/$method" $talk ${FLAGS:-} "${flags[@]}" > "$work/$method.json" 2> "$log" || rc=$?
-        [ -n "${KEEP:-}" ] && cp "$work/$method.json" "$KEEP/$tag.json"
+        if [ -n "${KEEP:-}" ]; then cp "$work/$method.json" "$KEEP/$tag.json"; fi
         /usr/bin/python3 - "$work/$method.json" "$method" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
