@@ -19,9 +19,9 @@ export FIBERNET_THREADS=${FIBERNET_THREADS:-1} OPENBLAS_NUM_THREADS=${OPENBLAS_N
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 timeout --signal=INT "$secs" perf record -q -e cpu-clock -F "${RATE:-199}" --call-graph dwarf,16384 \
     -o "$work/perf.data" -- "$@" >/dev/null 2>"$work/run.err" || true
-report() {  # --children | --no-children
+report() {  # --children | --no-children; head closing the pipe early is no error (pipefail)
     perf report -i "$work/perf.data" "$1" --sort symbol -g none 2>/dev/null | grep -v '^#' | grep '%' |
-        sed 's/  */ /g' | grep -v '0xffffffffffffffff' | cut -c1-150 | head -n "${TOP:-30}"
+        sed 's/  */ /g' | grep -v '0xffffffffffffffff' | cut -c1-150 | head -n "${TOP:-30}" || true
 }
 echo "inclusive (children, self) per function:"
 report --children

@@ -6,7 +6,8 @@
 // Exit 1 when a relaxation did not reach a stable equilibrium or the free box did not converge (results still
 // reported, marked). With -o, the directory's previous results are invalidated at the start, and the tables and
 // summary.json (complete: false) are rewritten after every beta; SIGINT/SIGTERM end the run at once with the finished
-// betas kept and reported (exit 130).
+// betas kept and reported (exit 130), and the smooth model's relaxation in progress in its last checkpoint
+// (wet_checkpoint.hpp: --checkpoint-seconds, --start-state).
 #include <algorithm>
 #include <unistd.h>
 
@@ -22,6 +23,7 @@
 #include <sstream>
 
 #include "common.hpp"
+#include "wet_checkpoint.hpp"
 #include "fibernet/export/vtp.hpp"
 #include "fibernet/model/model_io.hpp"
 #include "fibernet/energy/capillary.hpp"
@@ -37,8 +39,9 @@ nlohmann::json solve_json(const SolveResult& r, double tol);  // cmd_modulus.cpp
 
 namespace {
 // Interrupts (SIGINT, SIGTERM). A beta's relaxation cannot be stopped midway (run_wet has no stop hook, and one beta
-// can take minutes), so the handler ends the process at once with what is finished: the report of the finished betas
-// (prepared after each one) on stdout, a line on stderr, exit 130; their files are on disk already. The handler may run
+// can take minutes; the smooth model's writes checkpoints instead), so the handler ends the process at once with what
+// is finished: the report of the finished betas (prepared after each one) on stdout, a line on stderr, exit 130; their
+// files are on disk already. The handler may run
 // on any thread (OpenMP, OpenBLAS, FIBERNET_THREADS workers), so the main thread holds it off with g_state while it
 // writes files or changes the prepared texts (kWriting): a signal then is only noted (g_pending) and the writer exits
 // when done. Whoever moves kRunning -> kExiting exits; the other waits for it.
@@ -338,6 +341,14 @@ void register_wet(CLI::App& app) {
         const Model m = discretize(net, s.discretization);
         const Eigen::Matrix2d F = deformation(s.strain, s.gamma);
         const Eigen::Matrix2d B = F * m.box.B0();
+        std::optional<StartState> start;  // checked before any output
+        if (!s.wet.start_state.empty()) {
+            if (betas.size() != 1)
+                throw InputError("--start-state '" + s.wet.start_state + "' continues one relaxation: give one beta (" +
+                                 std::to_string(betas.size()) + " given)");
+            start = read_start_state(s.wet.start_state, m, F);
+            opt.wet_start = start->q;
+        }
         if (!w->out.empty()) {  // made (like mkdir -p) before any work, so a bad path costs no relaxation
             std::error_code ec;
             std::filesystem::create_directories(w->out, ec);
@@ -384,6 +395,8 @@ void register_wet(CLI::App& app) {
             {"crossing_width", s.wet.crossing_width},
             {"contact_distance", s.wet.contact_distance},
             {"skin", s.wet.skin},
+            {"checkpoint_seconds", s.wet.checkpoint_seconds},
+            {"start_state", start ? start->record : nlohmann::json()},
             {"free_box", s.wet.free_box},
             {"free_box_shape", s.wet.free_box ? nlohmann::json(s.wet.free_box_shape) : nlohmann::json()},
             {"free_box_tol", s.wet.free_box ? nlohmann::json(s.wet.free_box_tol) : nlohmann::json()},
@@ -409,6 +422,17 @@ void register_wet(CLI::App& app) {
                                 {"complete", complete},
                                 {"seconds", seconds_since(t_all)}};
         };
+        // The smooth relaxation's checkpoints (wet_checkpoint.hpp), written with the interrupt handler held off.
+        WetCheckpoints checkpoints(w->out.empty() ? "" : w->out + "/",
+                                   opt.model == WetModel::Smooth ? s.wet.checkpoint_seconds : 0.0, m, F,
+                                   {{"parameters", parameters}, {"wet", wet_settings}}, command_argv(),
+                                   start ? &*start : nullptr, [](const std::function<void()>& write) {
+                                       hold();
+                                       write();
+                                       release();
+                                   });
+        if (checkpoints.enabled())
+            opt.observe_wet = [&checkpoints](const Eigen::VectorXd& q, double e, double g) { checkpoints.observe(q, e, g); };
         // Before beta k: the files of the betas before it (at k = 0, none: the directory's previous results are
         // replaced at once, so an interrupted or failed rerun leaves no stale "complete" summary, rows or pictures),
         // and what an interrupt during beta k prints.
@@ -429,6 +453,7 @@ void register_wet(CLI::App& app) {
                         if (ec) throw InputError("--out-dir '" + w->out + "': cannot remove the previous " + f + " (" +
                                                  ec.message() + ")");
                     }
+                    checkpoints.remove_stale();
                 }
                 // The tables first, the summary last: a summary never lists a beta whose rows are not written yet.
                 write_file_atomic(dir + "sweep.csv", sweep.str());
@@ -447,6 +472,10 @@ void register_wet(CLI::App& app) {
                                                                                    "sweep.csv, pores.csv)") +
                                " and reported on stdout")
               << "\n";
+            if (checkpoints.enabled())
+                m << "wet: beta " << betas[k] << "'s relaxation continues from its last checkpoint, if one was written (every "
+                  << s.wet.checkpoint_seconds << " s): --start-state " << dir << "checkpoint_" << k
+                  << ".txt (the command is in checkpoint_" << k << ".json)\n";
             g_message = m.str();
         };
         // A fresh run: fibernet scan runs this command once per sample in one process, and the last run's final
@@ -471,8 +500,16 @@ void register_wet(CLI::App& app) {
                                   betas.size(), seconds_since(t_betas) / k * (betas.size() - k));
                 progress_line(line);
             }
+            checkpoints.begin(k, betas[k]);
             const WetRun r = run_wet(net, m, F, opt, k == 0 ? nullptr : &dry_state);
+            // An unconverged relaxation leaves its last state to continue from (never as a result: no state_<k>.txt).
+            const std::string left = r.wet.converged || opt.model != WetModel::Smooth
+                                         ? std::string()
+                                         : checkpoints.keep_last(r.wet.q, r.smooth.energy, r.smooth.grad_max);
             hold();  // beta k is finished: from here until its files are written, an interrupt waits
+            if (!left.empty())
+                std::fprintf(stderr, "wet: beta = %g did not converge; its last state is %s%s (continue with "
+                             "--start-state)\n", betas[k], dir.c_str(), left.c_str());
             if (!w->quiet) {
                 char line[400];
                 std::snprintf(line, sizeof line, "wet: beta = %g: %s, %zu bridges, %d solver iterations, %.1f s",
@@ -618,7 +655,9 @@ void register_wet(CLI::App& app) {
                 std::ostringstream vtp;
                 write_vtp(vtp, e, r.wet.q, F, vf);
                 write_file_atomic(dir + "state_" + std::to_string(k) + ".vtp", vtp.str());
+                checkpoints.discard();  // state_<k>.txt supersedes them
             }
+            if (!left.empty()) runs.back()["checkpoint"] = left;
             if (k + 1 < betas.size()) checkpoint(k + 1), release();
         }
         const nlohmann::json j = summary(true);

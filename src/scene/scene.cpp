@@ -81,6 +81,11 @@ void Scene::check_values() const {
     check_value(std::isfinite(wet.contact_distance) && wet.contact_distance >= 0, wet.contact_distance, source,
                 "[wet].contact_distance", "must be >= 0 (0: the fiber diameter)");
     check_value(std::isfinite(wet.skin) && wet.skin > 0, wet.skin, source, "[wet].skin", "must be > 0");
+    check_value(std::isfinite(wet.checkpoint_seconds) && wet.checkpoint_seconds >= 0, wet.checkpoint_seconds, source,
+                "[wet].checkpoint_seconds", "must be >= 0 (0: no checkpoints)");
+    if (wet.model != "smooth" && !wet.start_state.empty())
+        throw InputError(source + ": [wet].start_state = '" + wet.start_state +
+                         "' applies to [wet].model = 'smooth' only (the event model's state includes its bridge set)");
     if (wet.model != "smooth" && wet.newton_projected)
         throw InputError(source + ": [wet].newton_projected applies to [wet].model = 'smooth' only");
     if (wet.free_box_shape != "full" && wet.free_box_shape != "isotropic")
@@ -260,6 +265,8 @@ Scene load_scene(const std::string& path) {
     // So is a law table.
     if (!s.wet.law.empty() && std::filesystem::path(s.wet.law).is_relative())
         s.wet.law = (std::filesystem::path(path).parent_path() / s.wet.law).string();
+    if (!s.wet.start_state.empty() && std::filesystem::path(s.wet.start_state).is_relative())
+        s.wet.start_state = (std::filesystem::path(path).parent_path() / s.wet.start_state).string();
     if (!s.network_file.empty() && !std::filesystem::is_regular_file(s.network_file))
         throw InputError(path + ": [network].file = '" + s.network_file + "' is not a readable file");
     return s;

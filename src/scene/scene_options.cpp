@@ -164,6 +164,14 @@ std::vector<SceneOption> declare() {
              [](Scene& s) -> double& { return s.wet.contact_distance; }));
     add(real("wet", "skin", "--skin", "smooth model: neighbour-list skin, seed units (also Newton's largest step)",
              [](Scene& s) -> double& { return s.wet.skin; }));
+    add(real("wet", "checkpoint_seconds", "--checkpoint-seconds",
+             "smooth model with --out-dir: write the wet relaxation's current state as checkpoint_<k>.txt at most this "
+             "often, for --start-state after an interrupt (0: never; docs/wet.md)",
+             [](Scene& s) -> double& { return s.wet.checkpoint_seconds; }));
+    add(text("wet", "start_state", "--start-state",
+             "smooth model, one beta: start the wet relaxation from this state file of the same network (a "
+             "checkpoint_<k>.txt or state_<k>.txt of an earlier run) instead of the dry equilibrium",
+             [](Scene& s) -> std::string& { return s.wet.start_state; }));
     return v;
 }
 

@@ -93,6 +93,7 @@ SolveResult run_iterations(SolverRun& run, IterativeMethod& method, Eigen::Vecto
         if (s.advanced) {
             ++k;
             if (!method.reports_every_iteration()) run.tick(k, method.energy(), method.grad_max(), method.note());
+            if (run.options().observe) run.options().observe(q, method.energy(), method.grad_max());
         }
     }
     method.complete(run.result(), s, q);

@@ -32,6 +32,7 @@ void configure(SolverOptions& o, const SolverOptions& base, const SolverCapabili
     if (base.max_step == 0 && wet) o.max_step = opt.max_step < 0 ? W.params().skin : opt.max_step;
     o.projected = base.projected || (opt.projected && caps.projected && wet);
     o.ldl = !o.projected && (base.ldl || (opt.ldl && caps.ldl && wet));
+    if (opt.observe) o.observe = opt.observe;
 }
 
 void add(SmoothRelaxResult& R, const SolveResult& s) {

@@ -112,10 +112,12 @@ void run_wet_smooth(WetRun& run, const Network& net, const NetworkEnergy& dry, c
     if (sp.pair.crossing_width <= 0) sp.pair.crossing_width = r;
     if (sp.pair.contact <= 0) sp.pair.contact = 2 * r;
     if (sp.pair.overlap_width <= 0) sp.pair.overlap_width = r;
-    run.wet.q = run.dry.q;
+    run.wet.q = opt.wet_start.size() ? opt.wet_start : run.dry.q;
     SmoothWetEnergy W(dry, F, sp, dry_pairs, run.wet.q);
     run.initial_bridges = W.bridges(run.wet.q);
-    run.smooth = relax_smooth_wet(W, solver, run.wet.q, opt.smooth_relax);
+    SmoothRelaxOptions ro = opt.smooth_relax;
+    ro.observe = opt.observe_wet;
+    run.smooth = relax_smooth_wet(W, solver, run.wet.q, ro);
     run.seconds_wet_solve = run.smooth.seconds;
     run.active.seconds_solve = run.smooth.seconds;
     run.wet.converged = run.smooth.converged;
@@ -199,8 +201,14 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     }
     if (opt.free_box.enabled && !m.box.periodic)
         throw InputError("run_wet: the free box needs a periodic network (an open network has no box stress)");
+    if (opt.wet_start.size() && opt.model != WetModel::Smooth)
+        throw InputError("run_wet: a start state applies to the smooth model only (the event model's state includes its "
+                         "bridge set)");
     WetRun run;
     NetworkEnergy dry(m);
+    if (opt.wet_start.size() && opt.wet_start.size() != dry.num_dofs())
+        throw InputError("run_wet: the start state has " + std::to_string(opt.wet_start.size()) +
+                         " coordinates, the model " + std::to_string(dry.num_dofs()));
     const Eigen::Matrix2d B = F * m.box.B0();
     auto solver = make_solver(opt.solver, opt.solver_options);
     const WetParams none;  // beta = 0: the dry energy

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <thread>
+#include <vector>
 
 #include "fibernet/solve/solver_loop.hpp"
 #include "fibernet/util/error.hpp"
@@ -94,6 +95,30 @@ TEST_CASE("solver loop: converges at max|g| <= tol, counting only the iterations
     CHECK(m.completed);
     CHECK(r.local_solves == 7);
     CHECK(r.timings.total >= 0);
+}
+
+TEST_CASE("solver loop: observe sees each accepted iterate, the last one the returned state", "[solve][loop]") {
+    Quadratic f(2);
+    SolverOptions o;
+    o.tol = 1e-3;
+    std::vector<double> seen_q, seen_e, seen_g;
+    o.observe = [&](const Eigen::VectorXd& q, double e, double g) {
+        seen_q.push_back(q[0]), seen_e.push_back(e), seen_g.push_back(g);
+    };
+    Halving m;
+    m.idle = 3;  // idle calls are not iterates
+    Eigen::VectorXd q = Eigen::VectorXd::Constant(2, 1.0);
+    SolverRun run("halving", o, f, q);
+    const SolveResult r = run_iterations(run, m, q);
+    REQUIRE(r.status == SolveStatus::Converged);
+    REQUIRE(static_cast<int>(seen_q.size()) == r.iterations);
+    for (size_t k = 0; k < seen_q.size(); ++k) {
+        CHECK(seen_q[k] == std::ldexp(1.0, -static_cast<int>(k) - 1));
+        CHECK(seen_e[k] == seen_q[k] * seen_q[k]);  // 1/2 |q|^2 with two equal entries
+        CHECK(seen_g[k] == seen_q[k]);
+    }
+    CHECK(seen_q.back() == q[0]);
+    CHECK(seen_e.back() == r.energy);
 }
 
 TEST_CASE("solver loop: the iteration budget and the time budget end a solve, named", "[solve][loop]") {

@@ -1,6 +1,7 @@
 // `fibernet wet` end to end on a tiny network, and bad input: exit 2, a message naming the value, no output files.
 #include <catch2/catch.hpp>
 
+#include "../support/cli_background.hpp"
 #include "../support/cli_run.hpp"
 #include <cstdlib>
 #include <algorithm>
@@ -25,36 +26,12 @@ using clitest::tmpdir;
 using clitest::write;
 int run(const std::string& args) { return clitest::run("wet " + args); }
 
-// `fibernet wet ARGS` in the background (its own pid, so a signal reaches it and not a shell), stdout and stderr in
-// tmpdir()/bg_stdout and bg_stderr.
-pid_t start(const std::vector<std::string>& args) {
-    const pid_t pid = fork();
-    if (pid == 0) {
-        const int o = open((tmpdir() + "/bg_stdout").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        const int e = open((tmpdir() + "/bg_stderr").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        dup2(o, 1), dup2(e, 2);
-        std::signal(SIGINT, SIG_DFL);  // a test run in the background of a script inherits SIGINT ignored
-        std::vector<char*> argv{const_cast<char*>(FIBERNET_EXE), const_cast<char*>("wet")};
-        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        execv(FIBERNET_EXE, argv.data());
-        _exit(127);
-    }
-    return pid;
-}
+using clitest::wait_until;
 
-// Polls until `ready` holds while the process still runs (true), or it exits or 300 s pass (false; a run still
-// going is killed).
-bool wait_until(pid_t pid, const std::function<bool()>& ready) {
-    const auto t0 = std::chrono::steady_clock::now();
-    while (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(300)) {
-        if (ready()) return true;
-        if (waitpid(pid, nullptr, WNOHANG) == pid) return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    kill(pid, SIGKILL);
-    waitpid(pid, nullptr, 0);
-    return false;
+// `fibernet wet ARGS` in the background (clitest::start_background).
+pid_t start(std::vector<std::string> args) {
+    args.insert(args.begin(), "wet");
+    return clitest::start_background(args);
 }
 
 nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(slurp(path), nullptr, false); }

@@ -60,6 +60,8 @@ struct WetSettings {
     double crossing_width = 0;
     double contact_distance = 0;
     double skin = 0.5;
+    double checkpoint_seconds = 300;  // smooth model with -o: the wet relaxation's state written this often; 0: never
+    std::string start_state;          // smooth model: the wet relaxation starts from this state file (one beta)
 };
 
 struct Scene {

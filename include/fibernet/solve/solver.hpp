@@ -3,6 +3,8 @@
 // its iterations in the one loop of solver_loop.hpp, and is created by name from the registry (solver_registry.hpp),
 // so that `--solver` can pick any of them. Callers ask a solver what it can do (capabilities()) and copy it (clone()),
 // never which one it is.
+#include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -35,6 +37,10 @@ struct SolverOptions {
     double max_step = 0;     // Newton: no coordinate moves more than this in one step (the line search starts at the
                              // step scaled down to it, and a capped step counts as a shortened one); 0 = no cap.
                              // The smooth wet model sets it to its neighbour list's skin (smooth_wet_relax.hpp)
+    // Called with each accepted iterate q, its energy and max|g|, by the solvers that run the loop of solver_loop.hpp
+    // (Newton, L-BFGS, CG, FIRE; not NLopt or Ipopt, whose loops are their own): a caller's hook for checkpoints of
+    // long solves (`fibernet wet --checkpoint-seconds`). Empty: none.
+    std::function<void(const Eigen::VectorXd& q, double energy, double grad_max)> observe;
 
     // The one check of these options (every solver's constructor calls it): throws InputError("<where>: <name> = <v>
     // must ..."), `where` naming the solver.

@@ -10,6 +10,7 @@
 //     iterations are not Newton steps), the pattern fixed in each and rebuilt between them where it no longer covers
 //     the state (the list was rebuilt since, or a non-zero pair fell outside it).
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 
 #include "fibernet/solve/solver.hpp"
@@ -27,6 +28,8 @@ struct SmoothRelaxOptions {
     bool ldl = true;        // Newton's first rung by LDL^T with flipped negative pivots (SolverOptions::ldl), beta > 0
     bool projected = false; // projected Newton (SolverOptions::projected), beta > 0; takes precedence over ldl
     bool follow_pattern = true;  // false: rounds for every solver (tests: the two ways agree)
+    // Called with each accepted iterate of the relaxation, over all its rounds (SolverOptions::observe); empty: none.
+    std::function<void(const Eigen::VectorXd& q, double energy, double grad_max)> observe;
 };
 
 struct SmoothRelaxResult {

@@ -4,6 +4,7 @@
 // and wet; optionally the free box: the box deformation at which the wet network carries no macroscopic stress
 // (drying shrinkage). Shared by the CLI and bench/bench_wet.cpp.
 #include <Eigen/Core>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -45,6 +46,12 @@ struct WetRunOptions {
                                  // for the second difference at modulus_strain; see WetState)
     double modulus_strain = 1e-4;
     FreeBoxOptions free_box;
+    // The smooth model only (InputError otherwise): the wet relaxation starts from these coordinates (the dry energy's
+    // dofs, e.g. a checkpoint of an interrupted run) instead of the dry equilibrium; empty: from the dry equilibrium.
+    Eigen::VectorXd wet_start;
+    // The smooth model: called with each accepted iterate of the fixed-box wet relaxation (not of the moduli's or the
+    // free box's relaxations), e.g. to write checkpoints (SolverOptions::observe); empty: none.
+    std::function<void(const Eigen::VectorXd& q, double energy, double grad_max)> observe_wet;
 };
 
 struct WetState {

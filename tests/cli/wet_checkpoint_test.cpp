@@ -1,0 +1,135 @@
+// Checkpoints of `fibernet wet`'s smooth relaxation and --start-state (src/cli/wet_checkpoint.cpp), end to end: an
+// unconverged relaxation leaves its last state, a running one writes checkpoints that survive SIGINT, a continued
+// relaxation reaches an equilibrium without raising the energy, and bad start states exit 2 naming the file.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "../support/cli_background.hpp"
+#include "../support/cli_run.hpp"
+
+using clitest::exists;
+using clitest::run;
+using clitest::slurp;
+using clitest::tmpdir;
+
+namespace {
+nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(slurp(path), nullptr, false); }
+
+// A 64-fiber network whose smooth relaxation at beta = 0.1 takes a few hundred Newton iterations.
+const std::string kNetwork = "--L 2.5 --q 8 --pl 0.5 --seed 3 --wet-model smooth --bundle-partners 2 --no-moduli";
+
+// A scene that cuts the relaxation after 10 iterations and checkpoints at every iteration.
+std::string short_scene() {
+    const std::string path = tmpdir() + "/short.toml";
+    clitest::write(path, "[wet]\nmax_rounds = 1\nround_iterations = 10\ncheckpoint_seconds = 1e-9\n");
+    return path;
+}
+}  // namespace
+
+TEST_CASE("wet checkpoint: an unconverged relaxation leaves its last state, and --start-state continues it",
+          "[cli][wet][checkpoint]") {
+    const std::string a = tmpdir() + "/ck_a", b = tmpdir() + "/ck_b";
+    REQUIRE(std::system(("rm -rf " + a + " " + b).c_str()) == 0);
+    REQUIRE(run("wet " + short_scene() + " " + kNetwork + " -q --betas 0.1 -o " + a) == 1);
+    CHECK(slurp(tmpdir() + "/stderr").find("did not converge; its last state is " + a + "/checkpoint_0.txt") !=
+          std::string::npos);
+    const nlohmann::json s = read_json(a + "/summary.json");
+    CHECK(s["runs"][0]["status"] == "not_stable");
+    CHECK(s["runs"][0]["checkpoint"] == "checkpoint_0.txt");
+    CHECK(!exists(a + "/state_0.txt"));  // an unconverged state is no result
+    REQUIRE(slurp(a + "/checkpoint_0.txt").rfind("fibernet-model 2\n", 0) == 0);
+    const nlohmann::json c = read_json(a + "/checkpoint_0.json");
+    REQUIRE(c.is_object());
+    CHECK(c["fibernet_checkpoint"] == "wet");
+    CHECK(c["last"] == true);
+    // The budget (10 iterations) cut it: the checkpoint is its last iterate.
+    CHECK(c["iterations"] == s["runs"][0]["solver_iterations"]);
+    CHECK(c["iterations"].get<int>() >= 1);
+    CHECK(c["iterations"].get<int>() <= 10);
+    CHECK(c["beta"] == 0.1);
+    CHECK(c["grad_max"] == s["runs"][0]["smooth"]["grad_max"]);
+    CHECK(c["continue_with"].get<std::string>().find("--betas 0.1 --start-state " + a + "/checkpoint_0.txt") !=
+          std::string::npos);
+    const double e_checkpoint = c["energy"].get<double>();
+
+    // Continued with the default budget: an equilibrium of the whole energy, reached from the checkpoint without raising
+    // the energy (every accepted Newton step lowers it).
+    REQUIRE(run("wet " + kNetwork + " -v --betas 0.1 --tol 1e-8 --checkpoint-seconds 1e-9 --start-state " + a + "/checkpoint_0.txt -o " + b) == 0);
+    // Its first Newton iterate is the checkpoint's state: the model file holds the displacements exactly.
+    const std::string trace = slurp(tmpdir() + "/stderr");
+    const size_t first = trace.find("newton    0  E = ");
+    REQUIRE(first != std::string::npos);
+    const double e_start = std::strtod(trace.c_str() + first + 17, nullptr);
+    CHECK(std::abs(e_start - e_checkpoint) <= 1e-12 * std::abs(e_checkpoint));
+    const nlohmann::json t = read_json(b + "/summary.json");
+    const nlohmann::json& r = t["runs"][0];
+    CHECK(r["status"] == "stable");
+    CHECK(r["smooth"]["grad_max"].get<double>() <= 1e-8);
+    CHECK(r["energy"]["wet"]["total"].get<double>() <= e_checkpoint + 1e-9 * std::abs(e_checkpoint));
+    CHECK(t["wet"]["start_state"]["iterations_before"] == c["iterations"]);
+    CHECK(t["wet"]["start_state"]["file"] == a + "/checkpoint_0.txt");
+    CHECK(exists(b + "/state_0.txt"));
+    CHECK(!exists(b + "/checkpoint_0.txt"));  // converged: state_0.txt supersedes its checkpoints
+    CHECK(exists(a + "/checkpoint_0.txt"));   // the start state is the user's file: kept
+}
+
+TEST_CASE("wet checkpoint: a running relaxation's checkpoints survive SIGINT", "[cli][wet][checkpoint][signal]") {
+    const std::string out = tmpdir() + "/ck_sigint";
+    REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
+    // 250 fibers at beta = 0.05: a relaxation of many seconds, checkpointed every 0.2 s.
+    const pid_t pid = clitest::start_background({"wet", "--L", "5", "--q", "10", "--pl", "0.5", "--seed", "3",
+                                                 "--wet-model", "smooth", "--bundle-partners", "2", "--no-moduli",
+                                                 "--betas", "0.05", "--checkpoint-seconds", "0.2", "-q", "-o", out});
+    REQUIRE(clitest::wait_until(pid, [&] { return read_json(out + "/checkpoint_0.json").is_object(); }));
+    kill(pid, SIGINT);
+    int st = 0;
+    REQUIRE(waitpid(pid, &st, 0) == pid);
+    REQUIRE(WIFEXITED(st));
+    CHECK(WEXITSTATUS(st) == 130);
+    CHECK(slurp(tmpdir() + "/bg_stderr").find("--start-state " + out + "/checkpoint_0.txt") != std::string::npos);
+    const nlohmann::json c = read_json(out + "/checkpoint_0.json");
+    REQUIRE(c.is_object());
+    CHECK(c["last"] == false);
+    CHECK(c["iterations"].get<int>() >= 1);
+    CHECK(slurp(out + "/checkpoint_0.txt").rfind("fibernet-model 2\n", 0) == 0);
+    // The state is whole: it is accepted as a start state by a run of the same network (cut at once by the budget).
+    const std::string next = tmpdir() + "/ck_sigint_next";
+    REQUIRE(std::system(("rm -rf " + next).c_str()) == 0);
+    const int rc = run("wet " + short_scene() + " --L 5 --q 10 --pl 0.5 --seed 3 --wet-model smooth --bundle-partners 2 "
+                       "--no-moduli -q --betas 0.05 --start-state " + out + "/checkpoint_0.txt -o " + next);
+    CHECK((rc == 0 || rc == 1));
+    CHECK(read_json(next + "/summary.json")["wet"]["start_state"]["iterations_before"] == c["iterations"]);
+}
+
+TEST_CASE("wet checkpoint: bad start states exit 2, name the file and write nothing", "[cli][wet][checkpoint][input]") {
+    const std::string a = tmpdir() + "/ck_bad_src", out = tmpdir() + "/ck_bad_out";
+    REQUIRE(std::system(("rm -rf " + a + " " + out).c_str()) == 0);
+    REQUIRE(run("wet " + short_scene() + " " + kNetwork + " -q --betas 0.1 -o " + a) == 1);
+    const std::string state = a + "/checkpoint_0.txt";
+    REQUIRE(exists(state));
+    struct Case {
+        std::string args, message;
+    };
+    const Case cases[] = {
+        {kNetwork + " -q --betas 0.1 --start-state " + tmpdir() + "/missing.txt", "missing.txt' cannot be read"},
+        {kNetwork + " -q --betas 0.1 --start-state " + a + "/summary.json", "not a fibernet model file"},
+        {kNetwork + " -q --betas 0.1,0.2 --start-state " + state, "give one beta (2 given)"},
+        {"--L 2.5 --q 8 --pl 0.5 --seed 3 --no-moduli -q --betas 0.1 --start-state " + state,
+         "applies to [wet].model = 'smooth' only"},
+        {kNetwork + " -q --betas 0.1 --gamma 0.01 --start-state " + state, "written at box deformation F"},
+        {"--L 2.5 --q 8 --pl 0.5 --seed 4 --wet-model smooth --no-moduli -q --betas 0.1 --start-state " + state,
+         "is not this run's"},
+        {kNetwork + " -q --betas 0.1 --checkpoint-seconds -1", "[wet].checkpoint_seconds"},
+    };
+    for (const Case& k : cases) {
+        INFO(k.args);
+        CHECK(run("wet " + k.args + " -o " + out) == 2);
+        CHECK(slurp(tmpdir() + "/stderr").find(k.message) != std::string::npos);
+        CHECK(!exists(out + "/summary.json"));
+    }
+}
