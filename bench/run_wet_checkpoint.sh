@@ -46,7 +46,7 @@ printf "run\tstatus\tglobal_factorizations\tE_wet\tmax_g\tseconds_wet_solve\tche
 "${run[@]}" "${flags[@]}" -o "$work/a" > "$work/a.json"
 row uninterrupted "$work/a.json"
 rc=0
-timeout --signal=TERM "$secs" "${run[@]}" "${flags[@]}" --checkpoint-seconds "${CHECKPOINT:-10}" -o "$work/b" \
+timeout --preserve-status --signal=TERM "$secs" "${run[@]}" "${flags[@]}" --checkpoint-seconds "${CHECKPOINT:-10}" -o "$work/b" \
     > "$work/b.json" 2> "$work/b.err" || rc=$?
 [ -f "$work/b/checkpoint_0.json" ] || { echo "no checkpoint after $secs s (exit $rc)" >&2; cat "$work/b.err" >&2; exit 1; }
 row "interrupted at ${secs} s (exit $rc)" "$work/b.json" "$work/b/checkpoint_0.json"

@@ -237,6 +237,294 @@ nlohmann::json free_box_json(const FreeBoxResult& f, const FreeBoxOptions& o) {
               {"seconds", f.seconds}});
     return j;
 }
+struct WetFlags {
+    std::vector<std::string> betas;
+    std::string out;
+    bool no_moduli = false, verbose = false, quiet = false;
+    double modulus_strain = 0;
+};
+
+// The workflow's options from the scene and the command's flags; the law file's text in law_text (recorded in the
+// summary: the file may change or go). The moduli's strain is set by the caller.
+WetRunOptions run_options(const Scene& s, const WetFlags& w, std::string& law_text) {
+    WetRunOptions opt;
+    if (!s.wet.law.empty()) {
+        opt.params.law = CapillaryLaw::read(s.wet.law);
+        law_text = file_bytes(s.wet.law, "capillary law file");
+    }
+    opt.rule.which = parse_wet_which(s.wet.crossings);
+    opt.rule.fraction = s.wet.fraction, opt.rule.seed = s.wet.seed;
+    opt.solver = s.solver.name;
+    opt.solver_options.tol = s.solver.tol, opt.solver_options.max_iter = s.solver.max_iter;
+    opt.solver_options.eliminate = s.wet.newton_eliminate;
+    if (s.wet.model == "smooth") opt.solver_options.elimination.hops = s.wet.eliminate_hops;
+    opt.solver_options.verbose = w.verbose;
+    opt.active_set.verbose = w.verbose || !w.quiet;
+    opt.active_set.max_rounds = s.wet.max_rounds;
+    opt.active_set.round_iterations = s.wet.round_iterations;
+    opt.active_set.newton_ldl = s.wet.newton_ldl;
+    opt.active_set.local_fraction = s.wet.local_fraction;
+    opt.active_set.local_threshold = s.wet.local_threshold;
+    opt.active_set.local_hops = s.wet.local_hops;
+    opt.active_set.bundle_partners = s.wet.bundle_partners;
+    opt.model = parse_wet_model(s.wet.model);
+    opt.smooth.skin = s.wet.skin;
+    opt.smooth.bundle_partners = s.wet.bundle_partners;
+    opt.smooth.pair.crossing_width = s.wet.crossing_width;  // 0: from the model (run_wet)
+    opt.smooth.pair.contact = s.wet.contact_distance;
+    opt.smooth.pair.overlap_width = 0;  // the fiber radius
+    opt.smooth_relax.round_iterations = s.wet.round_iterations;
+    opt.smooth_relax.max_rounds = s.wet.max_rounds;
+    opt.smooth_relax.ldl = s.wet.newton_ldl;
+    opt.smooth_relax.projected = s.wet.newton_projected;
+    opt.smooth_relax.progress = w.verbose || !w.quiet;
+    opt.moduli = !w.no_moduli;
+    opt.free_box.enabled = s.wet.free_box;
+    opt.free_box.isotropic = s.wet.free_box_shape == "isotropic";
+    opt.free_box.tol = s.wet.free_box_tol;
+    opt.free_box.progress = !w.quiet;
+    return opt;
+}
+
+// summary.json's `wet` block: every [wet] setting the results depend on (docs/formats.md, "Wet scenes").
+nlohmann::json wet_settings_json(const Scene& s, const std::vector<double>& betas, const std::string& law_text,
+                                 const WetRunOptions& opt, const StartState* start) {
+    const bool fraction = s.wet.crossings == "fraction";
+    return nlohmann::json{
+        {"betas", betas},
+        {"law", s.wet.law.empty() ? "cos2" : s.wet.law},
+        {"law_table", s.wet.law.empty() ? nlohmann::json() : nlohmann::json(law_text)},
+        {"law_fnv1a", s.wet.law.empty() ? nlohmann::json() : nlohmann::json(fnv1a_bytes(law_text))},
+        {"crossings", s.wet.crossings},
+        {"fraction", s.wet.fraction},
+        {"seed", fraction ? nlohmann::json(s.wet.seed) : nlohmann::json()},  // no draw otherwise
+        {"max_rounds", s.wet.max_rounds},
+        {"round_iterations", s.wet.round_iterations},
+        {"newton_ldl", s.wet.newton_ldl},
+        {"newton_projected", s.wet.newton_projected},
+        {"local_fraction", s.wet.local_fraction},
+        {"local_threshold", s.wet.local_threshold},
+        {"local_hops", s.wet.local_hops},
+        {"bundle_partners", s.wet.bundle_partners},
+        {"model", s.wet.model},
+        {"crossing_width", s.wet.crossing_width},
+        {"contact_distance", s.wet.contact_distance},
+        {"skin", s.wet.skin},
+        {"checkpoint_seconds", s.wet.checkpoint_seconds},
+        {"start_state", start ? start->record : nlohmann::json()},
+        {"free_box", s.wet.free_box},
+        {"free_box_shape", s.wet.free_box ? nlohmann::json(s.wet.free_box_shape) : nlohmann::json()},
+        {"free_box_tol", s.wet.free_box ? nlohmann::json(s.wet.free_box_tol) : nlohmann::json()},
+        {"moduli", opt.moduli},
+        {"modulus_strain", opt.moduli ? nlohmann::json(opt.modulus_strain) : nlohmann::json()}};
+}
+
+// One row of sweep.csv (its header in register_wet).
+void sweep_row(std::ostream& sweep, double beta, const char* status, const WetRun& r, const WetState& dry_state,
+               bool free_box) {
+    const auto& pw = r.wet.pores.pores;
+    double sum = 0, dsum = 0;
+    for (const auto& p : pw) sum += p.area, dsum += p.diameter;
+    const int largest = r.bundles.sizes.empty() ? 1 : r.bundles.sizes.front();
+    sweep << beta << "," << status << "," << r.active.bridges.size() << ","
+          << r.active.events.moves << "," << r.active.events.ruptures << "," << r.active.events.formed << ","
+          << r.active.events.merged << "," << r.active.rounds << "," << r.wet.energy.stretch << ","
+          << r.wet.energy.bend << "," << r.wet.energy.capillary << "," << pw.size() << ","
+          << (pw.empty() ? 0 : sum / pw.size()) << "," << (pw.empty() ? 0 : dsum / pw.size()) << ","
+          << r.bundles.bundled_fibers << "," << largest << "," << dry_state.shear_modulus << ","
+          << r.wet.shear_modulus << "," << dry_state.shear_modulus_fd << "," << r.wet.shear_modulus_fd;
+    if (free_box)
+        sweep << "," << (r.free_box.converged ? "converged" : "not_converged") << "," << r.free_box.s << ","
+              << r.free_box.areal_shrinkage << "," << r.free_box.residual << "," << r.free_box.iterations << ","
+              << r.free_box.shear_modulus;
+    sweep << "\n";
+}
+
+// One run of summary.json's `runs` (docs/formats.md, "Wet scenes"); tol: the solver's, for its status.
+nlohmann::json run_json(double beta, const char* status, const WetRun& r, const WetState& dry_state,
+                        const WetRunOptions& opt, double tol) {
+    const int largest = r.bundles.sizes.empty() ? 1 : r.bundles.sizes.front();
+    nlohmann::json hist = nlohmann::json::object();
+    for (const auto& [size, count] : r.bundles.histogram) hist[std::to_string(size)] = count;
+    return nlohmann::json{{"beta", beta},
+         {"status", status},
+         {"message", r.active.message},
+         {"energy", {{"dry", energy_json(r.dry.energy)}, {"wet", energy_json(r.wet.energy)}}},
+         {"bridges", {{"initial", r.initial_bridges.size()}, {"final", r.active.bridges.size()}}},
+         {"events",
+          {{"moves", r.active.events.moves}, {"ruptures", r.active.events.ruptures},
+           {"formed", r.active.events.formed}, {"merged", r.active.events.merged},
+           {"locked", r.active.events.locked}, {"capped", r.active.events.capped}, {"rounds", r.active.rounds}, {"cycling", r.active.cycling},
+           {"cycles_broken", r.active.cycles_broken}, {"frozen_pairs", r.active.frozen_pairs},
+           {"local_rounds", r.active.local_rounds}, {"local_iterations", r.active.local_iterations}}},
+         {"bundles",
+          {{"bundled_fibers", r.bundles.bundled_fibers}, {"count", r.bundles.sizes.size()},
+           {"largest", largest}, {"size_histogram", hist}, {"aligned_bridges", r.bundles.aligned_bridges}}},
+         {"pores", {{"dry", pore_json(r.dry.pores)}, {"wet", pore_json(r.wet.pores)}}},
+         {"shear_modulus", {{"dry", num(dry_state.shear_modulus)}, {"wet", num(r.wet.shear_modulus)}}},
+         {"shear_modulus_error", {{"dry", num(dry_state.shear_modulus_error)}, {"wet", num(r.wet.shear_modulus_error)}}},
+         {"shear_modulus_second_difference",
+          {{"dry", num(dry_state.shear_modulus_fd)}, {"wet", num(r.wet.shear_modulus_fd)},
+           {"strain", opt.moduli ? nlohmann::json(opt.modulus_strain) : nlohmann::json()}}},
+         {"solver", solve_json(r.active.last, tol)},
+         {"free_box", opt.free_box.enabled ? free_box_json(r.free_box, opt.free_box) : nlohmann::json()},
+         {"solver_iterations", r.active.solver_iterations},
+         {"smooth", opt.model != WetModel::Smooth ? nlohmann::json()
+                                                 : nlohmann::json{{"rounds", r.smooth.rounds},
+                                                                  {"grad_max", r.smooth.grad_max},
+                                                                  {"list_builds", r.smooth.list_builds},
+                                                                  {"pattern_builds", r.smooth.pattern_builds},
+                                                                  {"stale_patterns", r.smooth.stale_patterns},
+                                                                  {"factorizations", r.smooth.factorizations},
+                                                                  {"local_solves", r.smooth.local_solves},
+                                                                  {"local_iterations", r.smooth.local_iterations},
+                                                                  {"eliminating_iterations",
+                                                                   r.smooth.eliminating_iterations},
+                                                                  {"seconds_patterns", r.smooth.seconds_patterns},
+                                                                  {"seconds_lists", r.smooth.seconds_lists},
+                                                                  {"seconds_solver",
+                                                                   {{"assembly", r.smooth.timings.assembly},
+                                                                    {"factorization",
+                                                                     r.smooth.timings.factorization},
+                                                                    {"line_search", r.smooth.timings.line_search},
+                                                                    {"total", r.smooth.timings.total}}}}},
+         {"seconds",
+          {{"dry", r.seconds_dry}, {"wet_solve", r.seconds_wet_solve}, {"events", r.seconds_events},
+           {"pores", r.seconds_pores}, {"moduli", r.seconds_moduli},
+           // parts: of wet_solve, the local rounds and, in them, building their pieces; of events, the bridge
+           // update and the next set's gradient
+           {"wet_local", r.active.seconds_local}, {"local_setup", r.active.seconds_local_setup},
+           {"bridge_update", r.active.seconds_update}, {"gradient", r.active.seconds_gradient}}}};
+}
+
+// Beta k's wet equilibrium as a model file (docs/formats.md: the fibers' state, exact) and for ParaView with the
+// bridges as vertices ("VTK"), written atomically into dir; returns the model file's name.
+std::string write_state(const std::string& dir, size_t k, double beta, const Model& m, const Eigen::Matrix2d& F,
+                        const WetRun& r) {
+    const NetworkEnergy e(m);
+    std::ostringstream state;
+    write_model(state, m, e.displacements(r.wet.q, F), F);
+    const std::string name = "state_" + std::to_string(k) + ".txt";
+    write_file_atomic(dir + name, state.str());
+    VtpFields vf;
+    const Eigen::VectorXd x = e.positions(r.wet.q, F);
+    for (const Bridge& b : r.active.bridges)
+        vf.bridges.push_back(bridge_point(m, b, x, F * m.box.B0())), vf.bridge_locked.push_back(b.locked);
+    vf.scalars = {{"beta", beta}};
+    std::ostringstream vtp;
+    write_vtp(vtp, e, r.wet.q, F, vf);
+    write_file_atomic(dir + "state_" + std::to_string(k) + ".vtp", vtp.str());
+    return name;
+}
+
+// pores.csv's rows, pores.svg's histograms and network.svg's panels (dry, then the last beta's wet state and its free
+// box), gathered beta by beta.
+struct WetPictures {
+    std::ostringstream pore_csv;
+    std::vector<SvgPanel> panels;
+    std::vector<std::string> hist_names;
+    std::vector<std::vector<double>> hist_values;
+    bool dry_written = false;
+
+    WetPictures() {
+        pore_csv << "state,beta,area,diameter\n";
+        pore_csv.precision(10);
+    }
+    void add(const WetRun& r, double beta, bool last, const Model& m, const Eigen::Matrix2d& F) {
+        const Eigen::Matrix2d B = F * m.box.B0();
+        const auto& pw = r.wet.pores.pores;
+        if (!dry_written) {
+            for (const auto& p : r.dry.pores.pores) pore_csv << "dry,0," << p.area << "," << p.diameter << "\n";
+            std::vector<double> d;
+            for (const auto& p : r.dry.pores.pores) d.push_back(p.diameter);
+            hist_names.push_back("dry"), hist_values.push_back(d);
+            NetworkEnergy e(m);
+            panels.push_back({"dry", e.positions(r.dry.q, F), B, {}, {}, {}});
+            dry_written = true;
+        }
+        for (const auto& p : pw) pore_csv << "wet," << beta << "," << p.area << "," << p.diameter << "\n";
+        std::vector<double> d;
+        for (const auto& p : pw) d.push_back(p.diameter);
+        std::ostringstream name;
+        name << "wet, beta = " << beta;
+        hist_names.push_back(name.str()), hist_values.push_back(d);
+        if (r.free_box.attempted) {
+            std::vector<double> fd;
+            for (const auto& p : r.free_box.pores.pores) {
+                pore_csv << "free_box," << beta << "," << p.area << "," << p.diameter << "\n";
+                fd.push_back(p.diameter);
+            }
+            hist_names.push_back(name.str() + ", free box"), hist_values.push_back(fd);
+        }
+        if (last) {
+            NetworkEnergy e(m);
+            std::vector<int> size(m.chains.size(), 0);
+            for (int lab : r.bundles.bundle_of_fiber) ++size[lab];
+            panels.push_back({name.str() + " (bridges red, bundles coloured)", e.positions(r.wet.q, F), B,
+                              r.active.bridges, r.bundles.bundle_of_fiber, size});
+            if (r.free_box.attempted) {
+                std::vector<int> fsize(m.chains.size(), 0);
+                for (int lab : r.free_box.bundles.bundle_of_fiber) ++fsize[lab];
+                std::ostringstream fname;
+                fname << name.str() << ", free box (" << (r.free_box.converged ? "" : "NOT converged, ")
+                      << "areal shrinkage " << r.free_box.areal_shrinkage << ")";
+                panels.push_back({fname.str(), e.positions(r.free_box.q, r.free_box.F),
+                                  r.free_box.F * m.box.B0(), r.free_box.bridges, r.free_box.bundles.bundle_of_fiber,
+                                  fsize});
+            }
+        }
+    }
+};
+
+// What a wet run is given: the scene with the command's flags, checked whole; the betas; the workflow's options; and
+// the law and network files' text, recorded in the summary (the files may change or go). InputError for bad input,
+// before any work.
+struct WetInputs {
+    Scene s;
+    std::vector<double> betas;
+    WetRunOptions opt;
+    std::string law_text, network_text;
+};
+
+WetInputs read_inputs(const SceneFlags& flags, const WetFlags& w, bool strain_given) {
+    WetInputs in;
+    Scene& s = in.s;
+    in.s = flags.resolve(false);  // checked whole below, with the [wet] flags in
+    refuse_trimmed_ends(s, "wet", "capillary bridges sit on the end arms");
+    if (flags.given("--eliminate"))  // else silently without effect here
+        throw InputError("command line: --eliminate and --no-eliminate set the dry solves' [solver] eliminate; the "
+                         "wet relaxation's is --wet-eliminate ([wet] newton_eliminate, off by default)");
+    if (flags.scene_file.empty() && !flags.given("--pl")) s.mikado.pl = 0.5;  // the thesis's wet networks
+    s.source = flags.scene_file.empty() ? "command line" : flags.scene_file + " + command line";
+    s.check();
+    record_scene(s);
+    in.betas = w.betas.empty() ? std::vector<double>{s.wet.beta} : parse_betas(w.betas);
+    for (double b : in.betas) s.check_beta(b, "command line", "--betas entry");
+
+    in.opt = run_options(s, w, in.law_text);
+    if (!s.network_file.empty()) in.network_text = file_bytes(s.network_file, "network file");
+    if (w.verbose && w.quiet) throw InputError("--verbose and --quiet contradict each other");
+    // The smooth model's pair sum lets fibers stack without bound; at strong wetting its answer then depends on the
+    // solver's path (docs/wet.md, "The partner cap in the smooth model"). Said once, quiet or not.
+    if (in.opt.model == WetModel::Smooth && s.wet.bundle_partners == 0 &&
+        *std::max_element(in.betas.begin(), in.betas.end()) >= 0.1)
+        std::fprintf(stderr,
+                     "wet: note: the smooth model without a partner cap at beta >= 0.1: fibers can stack without "
+                     "bound and the equilibrium found depends on the solver's path; --bundle-partners 2 caps it "
+                     "(docs/wet.md, \"The partner cap in the smooth model\")\n");
+    if (strain_given) {
+        check_value(std::isfinite(w.modulus_strain) && w.modulus_strain > 0 && w.modulus_strain <= 0.1,
+                    w.modulus_strain, "--modulus-strain", "modulus strain", "must be in (0, 0.1]");
+        if (w.no_moduli) throw InputError("--modulus-strain given with --no-moduli");
+        in.opt.modulus_strain = w.modulus_strain;
+    }
+    make_solver(in.opt.solver, in.opt.solver_options);  // an unknown solver is an InputError before any work
+    if (!s.wet.free_box && (flags.given("--free-box-shape") || flags.given("--free-box-tol")))
+        throw InputError(std::string(flags.given("--free-box-shape") ? "--free-box-shape" : "--free-box-tol") +
+                         " given without --free-box (or [wet] free_box = true)");
+    return in;
+}
+
 }  // namespace
 
 void register_wet(CLI::App& app) {
@@ -244,12 +532,6 @@ void register_wet(CLI::App& app) {
     auto flags = std::make_shared<SceneFlags>();
     flags->add(cmd, true, true);  // with [wet]'s flags: --beta, --law, --crossings, --fraction, --wet-seed, ...
     cmd->get_option("--pl")->description("crosslink probability in [0, 1] (default 0.5 here, as the thesis's wet networks)");
-    struct WetFlags {
-        std::vector<std::string> betas;
-        std::string out;
-        bool no_moduli = false, verbose = false, quiet = false;
-        double modulus_strain = 0;
-    };
     auto w = std::make_shared<WetFlags>();
     // Split by parse_betas, not by CLI11's delimiter, which drops empty entries.
     cmd->add_option("--betas", w->betas, "a beta sweep, comma-separated, e.g. --betas 0,0.1,0.3,1 (overrides --beta)");
@@ -264,83 +546,18 @@ void register_wet(CLI::App& app) {
     cmd->add_flag("-q,--quiet", w->quiet, "no progress lines on stderr (default: one per beta and per active-set round)");
     cmd->callback([=] {
         const auto t_all = std::chrono::steady_clock::now();
-        Scene s = flags->resolve(false);  // checked whole below, with the [wet] flags in
-        refuse_trimmed_ends(s, "wet", "capillary bridges sit on the end arms");
-        if (flags->given("--eliminate"))  // else silently without effect here
-            throw InputError("command line: --eliminate and --no-eliminate set the dry solves' [solver] eliminate; the "
-                             "wet relaxation's is --wet-eliminate ([wet] newton_eliminate, off by default)");
-        if (flags->scene_file.empty() && !flags->given("--pl")) s.mikado.pl = 0.5;  // the thesis's wet networks
-        s.source = flags->scene_file.empty() ? "command line" : flags->scene_file + " + command line";
-        s.check();
-        record_scene(s);
-        const std::vector<double> betas = w->betas.empty() ? std::vector<double>{s.wet.beta} : parse_betas(w->betas);
-        for (double b : betas) s.check_beta(b, "command line", "--betas entry");
-
-        WetRunOptions opt;
-        std::string law_text;  // recorded in the summary: the file may change or go
-        if (!s.wet.law.empty()) {
-            opt.params.law = CapillaryLaw::read(s.wet.law);
-            law_text = file_bytes(s.wet.law, "capillary law file");
-        }
-        std::string network_text;
-        if (!s.network_file.empty()) network_text = file_bytes(s.network_file, "network file");
-        opt.rule.which = parse_wet_which(s.wet.crossings);
-        opt.rule.fraction = s.wet.fraction, opt.rule.seed = s.wet.seed;
-        opt.solver = s.solver.name;
-        opt.solver_options.tol = s.solver.tol, opt.solver_options.max_iter = s.solver.max_iter;
-        opt.solver_options.eliminate = s.wet.newton_eliminate;
-        if (s.wet.model == "smooth") opt.solver_options.elimination.hops = s.wet.eliminate_hops;
-        opt.solver_options.verbose = w->verbose;
-        opt.active_set.verbose = w->verbose || !w->quiet;
-        opt.active_set.max_rounds = s.wet.max_rounds;
-        opt.active_set.round_iterations = s.wet.round_iterations;
-        opt.active_set.newton_ldl = s.wet.newton_ldl;
-        opt.active_set.local_fraction = s.wet.local_fraction;
-        opt.active_set.local_threshold = s.wet.local_threshold;
-        opt.active_set.local_hops = s.wet.local_hops;
-        opt.active_set.bundle_partners = s.wet.bundle_partners;
-        opt.model = parse_wet_model(s.wet.model);
-        opt.smooth.skin = s.wet.skin;
-        opt.smooth.bundle_partners = s.wet.bundle_partners;
-        opt.smooth.pair.crossing_width = s.wet.crossing_width;  // 0: from the model (run_wet)
-        opt.smooth.pair.contact = s.wet.contact_distance;
-        opt.smooth.pair.overlap_width = 0;  // the fiber radius
-        opt.smooth_relax.round_iterations = s.wet.round_iterations;
-        opt.smooth_relax.max_rounds = s.wet.max_rounds;
-        opt.smooth_relax.ldl = s.wet.newton_ldl;
-        opt.smooth_relax.projected = s.wet.newton_projected;
-        opt.smooth_relax.progress = w->verbose || !w->quiet;
-        if (w->verbose && w->quiet) throw InputError("--verbose and --quiet contradict each other");
-        // The smooth model's pair sum lets fibers stack without bound; at strong wetting its answer then depends on the
-        // solver's path (docs/wet.md, "The partner cap in the smooth model"). Said once, quiet or not.
-        if (opt.model == WetModel::Smooth && s.wet.bundle_partners == 0 &&
-            *std::max_element(betas.begin(), betas.end()) >= 0.1)
-            std::fprintf(stderr,
-                         "wet: note: the smooth model without a partner cap at beta >= 0.1: fibers can stack without "
-                         "bound and the equilibrium found depends on the solver's path; --bundle-partners 2 caps it "
-                         "(docs/wet.md, \"The partner cap in the smooth model\")\n");
-        opt.moduli = !w->no_moduli;
-        if (o_ms->count()) {
-            check_value(std::isfinite(w->modulus_strain) && w->modulus_strain > 0 && w->modulus_strain <= 0.1,
-                        w->modulus_strain, "--modulus-strain", "modulus strain", "must be in (0, 0.1]");
-            if (w->no_moduli) throw InputError("--modulus-strain given with --no-moduli");
-            opt.modulus_strain = w->modulus_strain;
-        }
-        make_solver(opt.solver, opt.solver_options);  // an unknown solver is an InputError before any work
-        if (!s.wet.free_box && (flags->given("--free-box-shape") || flags->given("--free-box-tol")))
-            throw InputError(std::string(flags->given("--free-box-shape") ? "--free-box-shape" : "--free-box-tol") +
-                             " given without --free-box (or [wet] free_box = true)");
-        opt.free_box.enabled = s.wet.free_box;
-        opt.free_box.isotropic = s.wet.free_box_shape == "isotropic";
-        opt.free_box.tol = s.wet.free_box_tol;
-        opt.free_box.progress = !w->quiet;
+        WetInputs in = read_inputs(*flags, *w, o_ms->count() > 0);
+        Scene& s = in.s;
+        const std::vector<double>& betas = in.betas;
+        WetRunOptions& opt = in.opt;
+        const std::string& law_text = in.law_text;
+        const std::string& network_text = in.network_text;
 
         const Network net = scene_network(s);
         if (s.wet.free_box && !net.periodic)
             throw InputError(s.source + ": the free box needs a periodic network (an open network has no box stress)");
         const Model m = discretize(net, s.discretization);
         const Eigen::Matrix2d F = deformation(s.strain, s.gamma);
-        const Eigen::Matrix2d B = F * m.box.B0();
         std::optional<StartState> start;  // checked before any output
         if (!s.wet.start_state.empty()) {
             if (betas.size() != 1)
@@ -358,50 +575,20 @@ void register_wet(CLI::App& app) {
         }
 
         nlohmann::json runs = nlohmann::json::array();
-        std::ostringstream sweep, pore_csv;
+        std::ostringstream sweep;
+        WetPictures pictures;
         sweep << "beta,status,bridges,moves,ruptures,formed,merged,rounds,E_stretch,E_bend,E_capillary,pores,mean_pore_area,"
                  "mean_pore_diameter,bundled_fibers,largest_bundle,G_dry,G_wet,G_dry_fd,G_wet_fd";
         if (opt.free_box.enabled) sweep << ",free_box,s,areal_shrinkage,free_box_residual,free_box_iterations,G_free_box";
         sweep << "\n";
-        pore_csv << "state,beta,area,diameter\n";
-        sweep.precision(10), pore_csv.precision(10);
-        bool ok = true, dry_written = false;
+        sweep.precision(10);
+        bool ok = true;
         WetState dry_state;
-        std::vector<SvgPanel> panels;
-        std::vector<std::string> hist_names;
-        std::vector<std::vector<double>> hist_values;
         // Everything the results depend on (docs/formats.md, "Wet scenes": summary.json), so that a run can be
         // repeated and a rerun told apart from it (bench/run_wet_pores.sh compares them before it skips a seed).
         nlohmann::json parameters = scene_parameters(s);  // which network the summary describes
         if (!s.network_file.empty()) parameters["network_file_fnv1a"] = fnv1a_bytes(network_text);
-        const bool fraction = s.wet.crossings == "fraction";
-        const nlohmann::json wet_settings = {
-            {"betas", betas},
-            {"law", s.wet.law.empty() ? "cos2" : s.wet.law},
-            {"law_table", s.wet.law.empty() ? nlohmann::json() : nlohmann::json(law_text)},
-            {"law_fnv1a", s.wet.law.empty() ? nlohmann::json() : nlohmann::json(fnv1a_bytes(law_text))},
-            {"crossings", s.wet.crossings},
-            {"fraction", s.wet.fraction},
-            {"seed", fraction ? nlohmann::json(s.wet.seed) : nlohmann::json()},  // no draw otherwise
-            {"max_rounds", s.wet.max_rounds},
-            {"round_iterations", s.wet.round_iterations},
-            {"newton_ldl", s.wet.newton_ldl},
-            {"newton_projected", s.wet.newton_projected},
-            {"local_fraction", s.wet.local_fraction},
-            {"local_threshold", s.wet.local_threshold},
-            {"local_hops", s.wet.local_hops},
-            {"bundle_partners", s.wet.bundle_partners},
-            {"model", s.wet.model},
-            {"crossing_width", s.wet.crossing_width},
-            {"contact_distance", s.wet.contact_distance},
-            {"skin", s.wet.skin},
-            {"checkpoint_seconds", s.wet.checkpoint_seconds},
-            {"start_state", start ? start->record : nlohmann::json()},
-            {"free_box", s.wet.free_box},
-            {"free_box_shape", s.wet.free_box ? nlohmann::json(s.wet.free_box_shape) : nlohmann::json()},
-            {"free_box_tol", s.wet.free_box ? nlohmann::json(s.wet.free_box_tol) : nlohmann::json()},
-            {"moduli", opt.moduli},
-            {"modulus_strain", opt.moduli ? nlohmann::json(opt.modulus_strain) : nlohmann::json()}};
+        const nlohmann::json wet_settings = wet_settings_json(s, betas, law_text, opt, start ? &*start : nullptr);
         const nlohmann::json command = command_line();
         auto summary = [&](bool complete) {
             return nlohmann::json{{"scene", s.source},
@@ -457,7 +644,7 @@ void register_wet(CLI::App& app) {
                 }
                 // The tables first, the summary last: a summary never lists a beta whose rows are not written yet.
                 write_file_atomic(dir + "sweep.csv", sweep.str());
-                write_file_atomic(dir + "pores.csv", pore_csv.str());
+                write_file_atomic(dir + "pores.csv", pictures.pore_csv.str());
                 emit_json(summary(false), dir + "summary.json");
             }
             nlohmann::json r = summary(false);
@@ -526,135 +713,16 @@ void register_wet(CLI::App& app) {
             const bool good = wet_good && box_good && moduli_good;
             const char* bad = !wet_good ? "not_stable" : !box_good ? "free_box_not_converged" : "modulus_failed";
             ok = ok && good;
-            const auto& pw = r.wet.pores.pores;
-            double sum = 0, dsum = 0;
-            for (const auto& p : pw) sum += p.area, dsum += p.diameter;
-            const int largest = r.bundles.sizes.empty() ? 1 : r.bundles.sizes.front();
-            sweep << betas[k] << "," << (good ? "ok" : bad) << "," << r.active.bridges.size() << ","
-                  << r.active.events.moves << "," << r.active.events.ruptures << "," << r.active.events.formed << ","
-                  << r.active.events.merged << "," << r.active.rounds << "," << r.wet.energy.stretch << ","
-                  << r.wet.energy.bend << "," << r.wet.energy.capillary << "," << pw.size() << ","
-                  << (pw.empty() ? 0 : sum / pw.size()) << "," << (pw.empty() ? 0 : dsum / pw.size()) << ","
-                  << r.bundles.bundled_fibers << "," << largest << "," << dry_state.shear_modulus << ","
-                  << r.wet.shear_modulus << "," << dry_state.shear_modulus_fd << "," << r.wet.shear_modulus_fd;
-            if (opt.free_box.enabled)
-                sweep << "," << (r.free_box.converged ? "converged" : "not_converged") << "," << r.free_box.s << ","
-                      << r.free_box.areal_shrinkage << "," << r.free_box.residual << "," << r.free_box.iterations << ","
-                      << r.free_box.shear_modulus;
-            sweep << "\n";
-            if (!dry_written) {
-                for (const auto& p : r.dry.pores.pores) pore_csv << "dry,0," << p.area << "," << p.diameter << "\n";
-                std::vector<double> d;
-                for (const auto& p : r.dry.pores.pores) d.push_back(p.diameter);
-                hist_names.push_back("dry"), hist_values.push_back(d);
-                NetworkEnergy e(m);
-                panels.push_back({"dry", e.positions(r.dry.q, F), B, {}, {}, {}});
-                dry_written = true;
-            }
-            for (const auto& p : pw) pore_csv << "wet," << betas[k] << "," << p.area << "," << p.diameter << "\n";
-            std::vector<double> d;
-            for (const auto& p : pw) d.push_back(p.diameter);
-            std::ostringstream name;
-            name << "wet, beta = " << betas[k];
-            hist_names.push_back(name.str()), hist_values.push_back(d);
-            if (r.free_box.attempted) {
-                std::vector<double> fd;
-                for (const auto& p : r.free_box.pores.pores) {
-                    pore_csv << "free_box," << betas[k] << "," << p.area << "," << p.diameter << "\n";
-                    fd.push_back(p.diameter);
-                }
-                hist_names.push_back(name.str() + ", free box"), hist_values.push_back(fd);
-            }
-            if (k + 1 == betas.size()) {
-                NetworkEnergy e(m);
-                std::vector<int> size(m.chains.size(), 0);
-                for (int lab : r.bundles.bundle_of_fiber) ++size[lab];
-                panels.push_back({name.str() + " (bridges red, bundles coloured)", e.positions(r.wet.q, F), B,
-                                  r.active.bridges, r.bundles.bundle_of_fiber, size});
-                if (r.free_box.attempted) {
-                    std::vector<int> fsize(m.chains.size(), 0);
-                    for (int lab : r.free_box.bundles.bundle_of_fiber) ++fsize[lab];
-                    std::ostringstream fname;
-                    fname << name.str() << ", free box (" << (r.free_box.converged ? "" : "NOT converged, ")
-                          << "areal shrinkage " << r.free_box.areal_shrinkage << ")";
-                    panels.push_back({fname.str(), e.positions(r.free_box.q, r.free_box.F),
-                                      r.free_box.F * m.box.B0(), r.free_box.bridges, r.free_box.bundles.bundle_of_fiber,
-                                      fsize});
-                }
-            }
-            nlohmann::json hist = nlohmann::json::object();
-            for (const auto& [size, count] : r.bundles.histogram) hist[std::to_string(size)] = count;
-            runs.push_back(
-                {{"beta", betas[k]},
-                 {"status", good ? "stable" : bad},
-                 {"message", r.active.message},
-                 {"energy", {{"dry", energy_json(r.dry.energy)}, {"wet", energy_json(r.wet.energy)}}},
-                 {"bridges", {{"initial", r.initial_bridges.size()}, {"final", r.active.bridges.size()}}},
-                 {"events",
-                  {{"moves", r.active.events.moves}, {"ruptures", r.active.events.ruptures},
-                   {"formed", r.active.events.formed}, {"merged", r.active.events.merged},
-                   {"locked", r.active.events.locked}, {"capped", r.active.events.capped}, {"rounds", r.active.rounds}, {"cycling", r.active.cycling},
-                   {"cycles_broken", r.active.cycles_broken}, {"frozen_pairs", r.active.frozen_pairs},
-                   {"local_rounds", r.active.local_rounds}, {"local_iterations", r.active.local_iterations}}},
-                 {"bundles",
-                  {{"bundled_fibers", r.bundles.bundled_fibers}, {"count", r.bundles.sizes.size()},
-                   {"largest", largest}, {"size_histogram", hist}, {"aligned_bridges", r.bundles.aligned_bridges}}},
-                 {"pores", {{"dry", pore_json(r.dry.pores)}, {"wet", pore_json(r.wet.pores)}}},
-                 {"shear_modulus", {{"dry", num(dry_state.shear_modulus)}, {"wet", num(r.wet.shear_modulus)}}},
-                 {"shear_modulus_error", {{"dry", num(dry_state.shear_modulus_error)}, {"wet", num(r.wet.shear_modulus_error)}}},
-                 {"shear_modulus_second_difference",
-                  {{"dry", num(dry_state.shear_modulus_fd)}, {"wet", num(r.wet.shear_modulus_fd)},
-                   {"strain", opt.moduli ? nlohmann::json(opt.modulus_strain) : nlohmann::json()}}},
-                 {"solver", solve_json(r.active.last, s.solver.tol)},
-                 {"free_box", opt.free_box.enabled ? free_box_json(r.free_box, opt.free_box) : nlohmann::json()},
-                 {"solver_iterations", r.active.solver_iterations},
-                 {"smooth", opt.model != WetModel::Smooth ? nlohmann::json()
-                                                         : nlohmann::json{{"rounds", r.smooth.rounds},
-                                                                          {"grad_max", r.smooth.grad_max},
-                                                                          {"list_builds", r.smooth.list_builds},
-                                                                          {"pattern_builds", r.smooth.pattern_builds},
-                                                                          {"stale_patterns", r.smooth.stale_patterns},
-                                                                          {"factorizations", r.smooth.factorizations},
-                                                                          {"local_solves", r.smooth.local_solves},
-                                                                          {"local_iterations", r.smooth.local_iterations},
-                                                                          {"eliminating_iterations",
-                                                                           r.smooth.eliminating_iterations},
-                                                                          {"seconds_patterns", r.smooth.seconds_patterns},
-                                                                          {"seconds_lists", r.smooth.seconds_lists},
-                                                                          {"seconds_solver",
-                                                                           {{"assembly", r.smooth.timings.assembly},
-                                                                            {"factorization",
-                                                                             r.smooth.timings.factorization},
-                                                                            {"line_search", r.smooth.timings.line_search},
-                                                                            {"total", r.smooth.timings.total}}}}},
-                 {"seconds",
-                  {{"dry", r.seconds_dry}, {"wet_solve", r.seconds_wet_solve}, {"events", r.seconds_events},
-                   {"pores", r.seconds_pores}, {"moduli", r.seconds_moduli},
-                   // parts: of wet_solve, the local rounds and, in them, building their pieces; of events, the bridge
-                   // update and the next set's gradient
-                   {"wet_local", r.active.seconds_local}, {"local_setup", r.active.seconds_local_setup},
-                   {"bridge_update", r.active.seconds_update}, {"gradient", r.active.seconds_gradient}}}});
+            sweep_row(sweep, betas[k], good ? "ok" : bad, r, dry_state, opt.free_box.enabled);
+            pictures.add(r, betas[k], k + 1 == betas.size(), m, F);
+            runs.push_back(run_json(betas[k], good ? "stable" : bad, r, dry_state, opt, s.solver.tol));
             // Finished betas survive an interrupt: the tables and summary.json (complete: false) are rewritten
             // (atomically) after each one; the pictures and stdout come at the end. After the last beta the handler
             // stays held off: the results are complete.
             // The wet equilibrium itself (model file, docs/formats.md): the fibers' state, exact; its bridges are in
             // the summary's counts and the pictures.
             if (!dir.empty() && r.wet.converged) {
-                const NetworkEnergy e(m);
-                std::ostringstream state;
-                write_model(state, m, e.displacements(r.wet.q, F), F);
-                const std::string name = "state_" + std::to_string(k) + ".txt";
-                write_file_atomic(dir + name, state.str());
-                runs.back()["state"] = name;
-                // The same for ParaView, with the bridges as vertices (docs/formats.md, "VTK").
-                VtpFields vf;
-                const Eigen::VectorXd x = e.positions(r.wet.q, F);
-                for (const Bridge& b : r.active.bridges)
-                    vf.bridges.push_back(bridge_point(m, b, x, F * m.box.B0())), vf.bridge_locked.push_back(b.locked);
-                vf.scalars = {{"beta", betas[k]}};
-                std::ostringstream vtp;
-                write_vtp(vtp, e, r.wet.q, F, vf);
-                write_file_atomic(dir + "state_" + std::to_string(k) + ".vtp", vtp.str());
+                runs.back()["state"] = write_state(dir, k, betas[k], m, F, r);
                 checkpoints.discard();  // state_<k>.txt supersedes them
             }
             if (!left.empty()) runs.back()["checkpoint"] = left;
@@ -663,9 +731,9 @@ void register_wet(CLI::App& app) {
         const nlohmann::json j = summary(true);
         if (!dir.empty()) {
             write_file_atomic(dir + "sweep.csv", sweep.str());
-            write_file_atomic(dir + "pores.csv", pore_csv.str());
-            write_file_atomic(dir + "network.svg", network_svg(m, panels));
-            write_file_atomic(dir + "pores.svg", histogram_svg(hist_names, hist_values, "pore equivalent diameter (seed units)"));
+            write_file_atomic(dir + "pores.csv", pictures.pore_csv.str());
+            write_file_atomic(dir + "network.svg", network_svg(m, pictures.panels));
+            write_file_atomic(dir + "pores.svg", histogram_svg(pictures.hist_names, pictures.hist_values, "pore equivalent diameter (seed units)"));
             emit_json(j, dir + "summary.json");
         }
         emit_json(j);
