@@ -222,7 +222,8 @@ std::optional<std::string>& recorded_scene() {
     return toml;
 }
 
-// A word of a command line as a POSIX shell reads it back.
+}  // namespace
+
 std::string shell_quoted(const std::string& w) {
     if (!w.empty() && w.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=/.,:@%") ==
                           std::string::npos)
@@ -231,7 +232,6 @@ std::string shell_quoted(const std::string& w) {
     for (char c : w) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
     return q + "'";
 }
-}  // namespace
 
 void forget_scene() { recorded_scene().reset(); }
 

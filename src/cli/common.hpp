@@ -111,6 +111,8 @@ std::function<void(const std::string&)>& progress_sink();
 
 // The command line as given (without the program name), set by main: recorded in results for provenance.
 std::vector<std::string>& command_argv();
+// A word of a command line as a POSIX shell reads it back (quoted where it needs to be).
+std::string shell_quoted(const std::string& w);
 
 // SIGINT and SIGTERM go to `handler` for the scope's life, unless the process started with one ignored (a shell
 // script's background job gets SIGINT so: Ctrl-C meant for the script must not stop it); the previous

@@ -38,15 +38,6 @@ std::string canonical(const std::string& path) {
 // The JSON beside a state file: checkpoint_3.txt -> checkpoint_3.json.
 std::string sidecar(const std::string& state) { return fs::path(state).replace_extension(".json").string(); }
 
-std::string shell_word(const std::string& w) {
-    if (!w.empty() && w.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-+=.,/:@%") ==
-                          std::string::npos)
-        return w;
-    std::string q = "'";
-    for (char c : w) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
 // This command without its betas and start state, to which a checkpoint's JSON adds its own.
 std::string continued_command(const std::vector<std::string>& argv) {
     std::string line = "fibernet";
@@ -58,7 +49,7 @@ std::string continued_command(const std::vector<std::string>& argv) {
             if (a == f) dropped = true, ++i;  // and its value
             else if (a.rfind(f + "=", 0) == 0) dropped = true;
         }
-        if (!dropped) line += " " + shell_word(a);
+        if (!dropped) line += " " + shell_quoted(a);
     }
     return line;
 }
@@ -192,7 +183,7 @@ void WetCheckpoints::write(const Eigen::VectorXd& q, double energy, double grad_
         {"iterations_total", before_it + iterations_},  // with the runs this one continued (--start-state)
         {"seconds_total", before_s + seconds},
         {"start_state", start_ ? start_->record : nlohmann::json()},
-        {"continue_with", hint_ + " --betas " + beta + " --start-state " + dir_ + stem + ".txt"},
+        {"continue_with", hint_ + " --betas " + beta + " --start-state " + shell_quoted(dir_ + stem + ".txt")},
         {"run", record_},
         {"provenance", provenance()}};
     guard_([&] {
