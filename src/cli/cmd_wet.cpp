@@ -613,7 +613,7 @@ void register_wet(CLI::App& app) {
         WetCheckpoints checkpoints(w->out.empty() ? "" : w->out + "/",
                                    opt.model == WetModel::Smooth ? s.wet.checkpoint_seconds : 0.0, m, F,
                                    {{"parameters", parameters}, {"wet", wet_settings}}, command_argv(),
-                                   start ? &*start : nullptr, [](const std::function<void()>& write) {
+                                   start ? &*start : nullptr, !w->quiet, [](const std::function<void()>& write) {
                                        hold();
                                        write();
                                        release();

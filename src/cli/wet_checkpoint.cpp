@@ -105,9 +105,9 @@ StartState read_start_state(const std::string& path, const Model& m, const Eigen
 
 WetCheckpoints::WetCheckpoints(std::string dir, double every, const Model& m, const Eigen::Matrix2d& F,
                                nlohmann::json record, const std::vector<std::string>& argv, const StartState* start,
-                               std::function<void(const std::function<void()>&)> guard)
+                               bool progress, std::function<void(const std::function<void()>&)> guard)
     : dir_(std::move(dir)), every_(every), m_(m), F_(F), record_(std::move(record)), hint_(continued_command(argv)),
-      start_(start), guard_(std::move(guard)) {}
+      start_(start), progress_(progress), guard_(std::move(guard)) {}
 
 void WetCheckpoints::begin(size_t k, double beta) {
     k_ = k, beta_ = beta, iterations_ = 0, written_ = false;
@@ -193,6 +193,9 @@ void WetCheckpoints::write(const Eigen::VectorXd& q, double energy, double grad_
     });
     last_ = std::chrono::steady_clock::now();
     written_ = true;
+    if (progress_ && !last)
+        std::fprintf(stderr, "wet: checkpoint at iteration %ld (E = %.10g, max|g| = %.3g): %s%s.txt\n", iterations_,
+                     energy, grad_max, dir_.c_str(), stem.c_str());
 }
 
 }  // namespace fibernet::cli

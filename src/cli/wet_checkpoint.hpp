@@ -38,8 +38,9 @@ public:
     // record: the run's parameters, echoed in each checkpoint's JSON; argv: this command's arguments (command_argv()),
     // from which the command that continues a checkpoint is built. `guard(write)` runs the writing (the CLI holds its
     // interrupt handler off meanwhile, so that an interrupt never leaves half a checkpoint).
+    // progress: a line on stderr per checkpoint written.
     WetCheckpoints(std::string dir, double every, const Model& m, const Eigen::Matrix2d& F, nlohmann::json record,
-                   const std::vector<std::string>& argv, const StartState* start,
+                   const std::vector<std::string>& argv, const StartState* start, bool progress,
                    std::function<void(const std::function<void()>&)> guard);
     bool enabled() const { return !dir_.empty() && every_ > 0; }
     // Beta k's relaxation starts: its clock and count.
@@ -67,6 +68,7 @@ private:
     nlohmann::json record_;
     std::string hint_;
     const StartState* start_;
+    bool progress_;
     std::function<void(const std::function<void()>&)> guard_;
     size_t k_ = 0;
     double beta_ = 0;

@@ -63,6 +63,7 @@ TEST_CASE("wet checkpoint: an unconverged relaxation leaves its last state, and 
     // Its first Newton iterate is the checkpoint's state: the model file holds the displacements exactly. (The trace
     // opens with the dry relaxation, which ends with its summary line "newton: <status> after ...".)
     const std::string trace = slurp(tmpdir() + "/stderr");
+    CHECK(trace.find("wet: checkpoint at iteration 1 ") != std::string::npos);  // progress names each checkpoint
     const size_t dry_end = trace.find("newton: ");
     REQUIRE(dry_end != std::string::npos);
     const size_t first = trace.find("newton    0  E = ", dry_end);
