@@ -245,6 +245,14 @@ TEST_CASE("run_wet refuses what the CLI refuses, and computes no modulus for an 
     WetRunOptions fb = opt;
     fb.free_box.enabled = true;
     CHECK_THROWS_WITH(run_wet(open, mo, Eigen::Matrix2d::Identity(), fb), Catch::Contains("periodic"));
+    // A start state on the event model (its state includes the bridge set), and one of the wrong size.
+    const Model ms = model_of(net, 10);
+    WetRunOptions start = opt;
+    start.wet_start = Eigen::VectorXd::Zero(NetworkEnergy(ms).num_dofs());
+    CHECK_THROWS_WITH(run_wet(net, ms, Eigen::Matrix2d::Identity(), start), Catch::Contains("smooth model only"));
+    start.model = WetModel::Smooth;
+    start.wet_start = Eigen::VectorXd::Zero(3);
+    CHECK_THROWS_WITH(run_wet(net, ms, Eigen::Matrix2d::Identity(), start), Catch::Contains("the start state has 3 coordinates"));
     // Stopped after 2 rounds: the last solve converged but the set is not stable, so no modulus (before: a G of an
     // inconsistent set, 0.00983 against the stable 0.01178 on problems/wet.toml).
     const Model m = model_of(net, 10);
