@@ -525,6 +525,262 @@ WetInputs read_inputs(const SceneFlags& flags, const WetFlags& w, bool strain_gi
     return in;
 }
 
+// Checked before any output: the network (the free box needs a periodic one).
+Network wet_network(const Scene& s) {
+    Network net = scene_network(s);
+    if (s.wet.free_box && !net.periodic)
+        throw InputError(s.source + ": the free box needs a periodic network (an open network has no box stress)");
+    return net;
+}
+
+// --out-dir: made (like mkdir -p) before any work, so a bad path costs no relaxation; returned with its '/' ("" for
+// none).
+std::string made_out_dir(const std::string& out) {
+    if (out.empty()) return "";
+    std::error_code ec;
+    std::filesystem::create_directories(out, ec);
+    if (ec || !std::filesystem::is_directory(out))
+        throw InputError("--out-dir '" + out + "': cannot create the directory" +
+                         (ec ? " (" + ec.message() + ")" : std::string(" (a file of that name exists)")));
+    return out + "/";
+}
+
+// One `fibernet wet` run (register_wet's callback): the betas in turn; after each, its row, pores and state, and the
+// tables and summary rewritten (complete: false) with what an interrupt then reports; at the end the pictures and the
+// complete summary. The constructor checks what is left to check (InputError) before anything is written.
+class WetSweep {
+public:
+    WetSweep(WetInputs in, const WetFlags& w, std::chrono::steady_clock::time_point t_all)
+        : in_(std::move(in)), w_(w), t_all_(t_all), net_(wet_network(in_.s)), m_(discretize(net_, in_.s.discretization)),
+          F_(deformation(in_.s.strain, in_.s.gamma)), start_(start_state()), dir_(made_out_dir(w.out)),
+          parameters_(parameters()), wet_settings_(wet_settings_json(in_.s, in_.betas, in_.law_text, in_.opt,
+                                                                     start_ ? &*start_ : nullptr)),
+          command_(command_line()),
+          checkpoints_(dir_, in_.opt.model == WetModel::Smooth ? in_.s.wet.checkpoint_seconds : 0.0, m_, F_,
+                       {{"parameters", parameters_}, {"wet", wet_settings_}}, command_argv(),
+                       start_ ? &*start_ : nullptr, !w.quiet, [](const std::function<void()>& write) {
+                           hold();
+                           write();
+                           release();
+                       }) {
+        if (start_) in_.opt.wet_start = start_->q;
+        if (checkpoints_.enabled())
+            in_.opt.observe_wet = [this](const Eigen::VectorXd& q, double e, double g) { checkpoints_.observe(q, e, g); };
+        sweep_ << "beta,status,bridges,moves,ruptures,formed,merged,rounds,E_stretch,E_bend,E_capillary,pores,"
+                  "mean_pore_area,mean_pore_diameter,bundled_fibers,largest_bundle,G_dry,G_wet,G_dry_fd,G_wet_fd";
+        if (in_.opt.free_box.enabled)
+            sweep_ << ",free_box,s,areal_shrinkage,free_box_residual,free_box_iterations,G_free_box";
+        sweep_ << "\n";
+        sweep_.precision(10);
+    }
+    WetSweep(const WetSweep&) = delete;
+    WetSweep& operator=(const WetSweep&) = delete;
+
+    // False when some beta is not a stable equilibrium, its free box did not converge or its moduli failed.
+    bool run() {
+        // A fresh run: fibernet scan runs this command once per sample in one process, and the last run's final
+        // write left the state held (kWriting), where hold() would wait for ever.
+        g_state = kRunning, g_pending = false;
+        hold();  // before the handler exists: nothing to report until before_beta(0) has run
+        // Inside fibernet scan (its JSON captured) the scan's handler stays: an interrupt ends the scan after this
+        // sample, not the process in the middle of it.
+        std::optional<InterruptScope> interrupts;
+        if (!json_capture()) interrupts.emplace();
+        before_beta(0);
+        release();
+        t_betas_ = std::chrono::steady_clock::now();
+        for (size_t k = 0; k < in_.betas.size(); ++k) {
+            run_beta(k);
+            // After the last beta the handler stays held off: the results are complete.
+            if (k + 1 < in_.betas.size()) before_beta(k + 1), release();
+        }
+        finish();
+        return ok_;
+    }
+
+private:
+    // --start-state, checked before any output: one beta only.
+    std::optional<StartState> start_state() const {
+        if (in_.s.wet.start_state.empty()) return std::nullopt;
+        if (in_.betas.size() != 1)
+            throw InputError("--start-state '" + in_.s.wet.start_state + "' continues one relaxation: give one beta (" +
+                             std::to_string(in_.betas.size()) + " given)");
+        return read_start_state(in_.s.wet.start_state, m_, F_);
+    }
+
+    // Everything the results depend on (docs/formats.md, "Wet scenes": summary.json), so that a run can be repeated
+    // and a rerun told apart from it (bench/run_wet_pores.sh compares them before it skips a seed).
+    nlohmann::json parameters() const {
+        nlohmann::json p = scene_parameters(in_.s);  // which network the summary describes
+        if (!in_.s.network_file.empty()) p["network_file_fnv1a"] = fnv1a_bytes(in_.network_text);
+        return p;
+    }
+
+    nlohmann::json summary(bool complete) const {
+        const Scene& s = in_.s;
+        return nlohmann::json{{"scene", s.source},
+                              {"command", command_},
+                              {"parameters", parameters_},
+                              {"prune", prune_rules(s)},
+                              {"network", to_json(statistics(net_))},
+                              {"model", to_json(summarize(m_))},
+                              {"wet", wet_settings_},
+                              {"strain", to_string(s.strain)},
+                              {"gamma", s.gamma},
+                              {"solver", {{"name", s.solver.name}, {"tol", s.solver.tol}, {"max_iter", s.solver.max_iter},
+                                          {"eliminate", s.wet.newton_eliminate},
+                                          {"eliminate_hops", s.wet.newton_eliminate && s.wet.model == "smooth"
+                                                                 ? nlohmann::json(s.wet.eliminate_hops)
+                                                                 : nlohmann::json()}}},
+                              {"runs", runs_},
+                              {"complete", complete},
+                              {"seconds", seconds_since(t_all_)}};
+    }
+
+    // At the start: the directory's previous results are replaced at once, so an interrupted or failed rerun leaves
+    // no stale "complete" summary, rows or pictures (drawn at the end only; until then none of another run).
+    void remove_previous() const {
+        std::vector<std::string> stale = {"network.svg", "pores.svg"};
+        std::error_code ec;
+        for (const auto& f : std::filesystem::directory_iterator(dir_, ec)) {
+            const std::string n = f.path().filename().string();
+            const std::string ext = n.size() > 10 ? n.substr(n.size() - 4) : "";
+            if (n.rfind("state_", 0) == 0 && (ext == ".txt" || ext == ".vtp")) stale.push_back(n);
+        }
+        for (const auto& f : stale) {
+            std::filesystem::remove(dir_ + f, ec);
+            if (ec) throw InputError("--out-dir '" + w_.out + "': cannot remove the previous " + f + " (" + ec.message() + ")");
+        }
+        checkpoints_.remove_stale();
+    }
+
+    // Before beta k (the handler held off): the files of the betas before it (at k = 0, none), and what an interrupt
+    // during beta k prints.
+    void before_beta(size_t k) {
+        if (!dir_.empty()) {
+            if (k == 0) remove_previous();
+            // The tables first, the summary last: a summary never lists a beta whose rows are not written yet.
+            write_file_atomic(dir_ + "sweep.csv", sweep_.str());
+            write_file_atomic(dir_ + "pores.csv", pictures_.pore_csv.str());
+            emit_json(summary(false), dir_ + "summary.json");
+        }
+        nlohmann::json r = summary(false);
+        r["interrupted"] = true;
+        r["provenance"] = provenance();
+        g_report = json_text(r, 2) + "\n";
+        g_message = interrupt_message(k);
+    }
+
+    std::string interrupt_message(size_t k) const {
+        const std::vector<double>& betas = in_.betas;
+        std::ostringstream m;
+        m << "wet: interrupted during beta = " << betas[k] << " (" << k + 1 << " of " << betas.size() << "); "
+          << (k == 0 ? std::string("no beta finished")
+                     : std::to_string(k) + " finished beta(s) kept" +
+                           (dir_.empty() ? std::string("")
+                                         : " in " + w_.out + " (summary.json: complete false, sweep.csv, pores.csv)") +
+                           " and reported on stdout")
+          << "\n";
+        if (checkpoints_.enabled())
+            m << "wet: beta " << betas[k] << "'s relaxation continues from its last checkpoint, if one was written (every "
+              << in_.s.wet.checkpoint_seconds << " s): --start-state " << dir_ << "checkpoint_" << k
+              << ".txt (the command is in checkpoint_" << k << ".json)\n";
+        return m.str();
+    }
+
+    void progress_before(size_t k) const {
+        if (w_.quiet) return;
+        const std::vector<double>& betas = in_.betas;
+        // ETA: the betas left at the mean time of those done (larger betas usually take longer: a floor).
+        char line[160];
+        if (k == 0) std::snprintf(line, sizeof line, "wet: beta = %g (1 of %zu)", betas[k], betas.size());
+        else
+            std::snprintf(line, sizeof line, "wet: beta = %g (%zu of %zu), ETA %.0f s", betas[k], k + 1, betas.size(),
+                          seconds_since(t_betas_) / k * (betas.size() - k));
+        progress_line(line);
+    }
+
+    // Beta k relaxed, then (the handler held off until the caller releases it) its row, pores, run and state.
+    void run_beta(size_t k) {
+        WetRunOptions& opt = in_.opt;
+        const double beta = in_.betas[k];
+        opt.params.beta = beta;
+        progress_before(k);
+        checkpoints_.begin(k, beta);
+        const WetRun r = run_wet(net_, m_, F_, opt, k == 0 ? nullptr : &dry_state_);
+        // An unconverged relaxation leaves its last state to continue from (never as a result: no state_<k>.txt).
+        const std::string left = r.wet.converged || opt.model != WetModel::Smooth
+                                     ? std::string()
+                                     : checkpoints_.keep_last(r.wet.q, r.smooth.energy, r.smooth.grad_max);
+        hold();  // beta k is finished: from here until its files are written, an interrupt waits
+        if (!left.empty())
+            std::fprintf(stderr, "wet: beta = %g did not converge; its last state is %s%s (continue with "
+                         "--start-state)\n", beta, dir_.c_str(), left.c_str());
+        if (!w_.quiet) {
+            char line[400];
+            std::snprintf(line, sizeof line, "wet: beta = %g: %s, %zu bridges, %d solver iterations, %.1f s", beta,
+                          r.active.message.c_str(), r.active.bridges.size(), r.active.solver_iterations,
+                          r.active.seconds_solve + r.active.seconds_events);
+            progress_line(line);
+        }
+        if (k == 0) dry_state_ = r.dry;
+        const char* status = run_status(r);
+        ok_ = ok_ && std::string(status) == "stable";
+        sweep_row(sweep_, beta, std::string(status) == "stable" ? "ok" : status, r, dry_state_, opt.free_box.enabled);
+        pictures_.add(r, beta, k + 1 == in_.betas.size(), m_, F_);
+        runs_.push_back(run_json(beta, status, r, dry_state_, opt, in_.s.solver.tol));
+        // The wet equilibrium itself (model file, docs/formats.md): the fibers' state, exact; its bridges are in the
+        // summary's counts and the pictures.
+        if (!dir_.empty() && r.wet.converged) {
+            runs_.back()["state"] = write_state(dir_, k, beta, m_, F_, r);
+            checkpoints_.discard();  // state_<k>.txt supersedes them
+        }
+        if (!left.empty()) runs_.back()["checkpoint"] = left;
+    }
+
+    // "stable", or why not: moduli asked for and not computed (a linear solve that failed) fail the run, as in
+    // `fibernet modulus`.
+    const char* run_status(const WetRun& r) const {
+        const WetRunOptions& opt = in_.opt;
+        if (!(r.dry.converged && r.wet.converged && r.active.stable)) return "not_stable";
+        if (opt.free_box.enabled && !r.free_box.converged) return "free_box_not_converged";
+        if (opt.moduli && !(std::isfinite(dry_state_.shear_modulus) && std::isfinite(r.wet.shear_modulus)))
+            return "modulus_failed";
+        return "stable";
+    }
+
+    // The pictures and the complete summary; the summary on stdout.
+    void finish() const {
+        const nlohmann::json j = summary(true);
+        if (!dir_.empty()) {
+            write_file_atomic(dir_ + "sweep.csv", sweep_.str());
+            write_file_atomic(dir_ + "pores.csv", pictures_.pore_csv.str());
+            write_file_atomic(dir_ + "network.svg", network_svg(m_, pictures_.panels));
+            write_file_atomic(dir_ + "pores.svg", histogram_svg(pictures_.hist_names, pictures_.hist_values,
+                                                                "pore equivalent diameter (seed units)"));
+            emit_json(j, dir_ + "summary.json");
+        }
+        emit_json(j);
+    }
+
+    WetInputs in_;
+    const WetFlags& w_;
+    const std::chrono::steady_clock::time_point t_all_;
+    const Network net_;
+    const Model m_;
+    const Eigen::Matrix2d F_;
+    const std::optional<StartState> start_;
+    const std::string dir_;  // --out-dir with its '/', or ""
+    const nlohmann::json parameters_, wet_settings_, command_;
+    WetCheckpoints checkpoints_;
+    nlohmann::json runs_ = nlohmann::json::array();
+    std::ostringstream sweep_;
+    WetPictures pictures_;
+    WetState dry_state_;
+    std::chrono::steady_clock::time_point t_betas_;
+    bool ok_ = true;
+};
+
 }  // namespace
 
 void register_wet(CLI::App& app) {
@@ -546,198 +802,8 @@ void register_wet(CLI::App& app) {
     cmd->add_flag("-q,--quiet", w->quiet, "no progress lines on stderr (default: one per beta and per active-set round)");
     cmd->callback([=] {
         const auto t_all = std::chrono::steady_clock::now();
-        WetInputs in = read_inputs(*flags, *w, o_ms->count() > 0);
-        Scene& s = in.s;
-        const std::vector<double>& betas = in.betas;
-        WetRunOptions& opt = in.opt;
-        const std::string& law_text = in.law_text;
-        const std::string& network_text = in.network_text;
-
-        const Network net = scene_network(s);
-        if (s.wet.free_box && !net.periodic)
-            throw InputError(s.source + ": the free box needs a periodic network (an open network has no box stress)");
-        const Model m = discretize(net, s.discretization);
-        const Eigen::Matrix2d F = deformation(s.strain, s.gamma);
-        std::optional<StartState> start;  // checked before any output
-        if (!s.wet.start_state.empty()) {
-            if (betas.size() != 1)
-                throw InputError("--start-state '" + s.wet.start_state + "' continues one relaxation: give one beta (" +
-                                 std::to_string(betas.size()) + " given)");
-            start = read_start_state(s.wet.start_state, m, F);
-            opt.wet_start = start->q;
-        }
-        if (!w->out.empty()) {  // made (like mkdir -p) before any work, so a bad path costs no relaxation
-            std::error_code ec;
-            std::filesystem::create_directories(w->out, ec);
-            if (ec || !std::filesystem::is_directory(w->out))
-                throw InputError("--out-dir '" + w->out + "': cannot create the directory" +
-                                 (ec ? " (" + ec.message() + ")" : std::string(" (a file of that name exists)")));
-        }
-
-        nlohmann::json runs = nlohmann::json::array();
-        std::ostringstream sweep;
-        WetPictures pictures;
-        sweep << "beta,status,bridges,moves,ruptures,formed,merged,rounds,E_stretch,E_bend,E_capillary,pores,mean_pore_area,"
-                 "mean_pore_diameter,bundled_fibers,largest_bundle,G_dry,G_wet,G_dry_fd,G_wet_fd";
-        if (opt.free_box.enabled) sweep << ",free_box,s,areal_shrinkage,free_box_residual,free_box_iterations,G_free_box";
-        sweep << "\n";
-        sweep.precision(10);
-        bool ok = true;
-        WetState dry_state;
-        // Everything the results depend on (docs/formats.md, "Wet scenes": summary.json), so that a run can be
-        // repeated and a rerun told apart from it (bench/run_wet_pores.sh compares them before it skips a seed).
-        nlohmann::json parameters = scene_parameters(s);  // which network the summary describes
-        if (!s.network_file.empty()) parameters["network_file_fnv1a"] = fnv1a_bytes(network_text);
-        const nlohmann::json wet_settings = wet_settings_json(s, betas, law_text, opt, start ? &*start : nullptr);
-        const nlohmann::json command = command_line();
-        auto summary = [&](bool complete) {
-            return nlohmann::json{{"scene", s.source},
-                                {"command", command},
-                                {"parameters", parameters},
-                                {"prune", prune_rules(s)},
-                                {"network", to_json(statistics(net))},
-                                {"model", to_json(summarize(m))},
-                                {"wet", wet_settings},
-                                {"strain", to_string(s.strain)},
-                                {"gamma", s.gamma},
-                                {"solver", {{"name", s.solver.name}, {"tol", s.solver.tol}, {"max_iter", s.solver.max_iter},
-                                            {"eliminate", s.wet.newton_eliminate},
-                                            {"eliminate_hops", s.wet.newton_eliminate && s.wet.model == "smooth"
-                                                                   ? nlohmann::json(s.wet.eliminate_hops)
-                                                                   : nlohmann::json()}}},
-                                {"runs", runs},
-                                {"complete", complete},
-                                {"seconds", seconds_since(t_all)}};
-        };
-        // The smooth relaxation's checkpoints (wet_checkpoint.hpp), written with the interrupt handler held off.
-        WetCheckpoints checkpoints(w->out.empty() ? "" : w->out + "/",
-                                   opt.model == WetModel::Smooth ? s.wet.checkpoint_seconds : 0.0, m, F,
-                                   {{"parameters", parameters}, {"wet", wet_settings}}, command_argv(),
-                                   start ? &*start : nullptr, !w->quiet, [](const std::function<void()>& write) {
-                                       hold();
-                                       write();
-                                       release();
-                                   });
-        if (checkpoints.enabled())
-            opt.observe_wet = [&checkpoints](const Eigen::VectorXd& q, double e, double g) { checkpoints.observe(q, e, g); };
-        // Before beta k: the files of the betas before it (at k = 0, none: the directory's previous results are
-        // replaced at once, so an interrupted or failed rerun leaves no stale "complete" summary, rows or pictures),
-        // and what an interrupt during beta k prints.
-        const std::string dir = w->out.empty() ? "" : w->out + "/";
-        auto checkpoint = [&](size_t k) {
-            if (!dir.empty()) {
-                if (k == 0) {  // drawn at the end only; until then no pictures (or states) of another run
-                    std::vector<std::string> stale = {"network.svg", "pores.svg"};
-                    std::error_code ec;
-                    for (const auto& f : std::filesystem::directory_iterator(dir, ec)) {
-                        const std::string n = f.path().filename().string();
-                        const std::string ext = n.size() > 10 ? n.substr(n.size() - 4) : "";
-                        if (n.rfind("state_", 0) == 0 && (ext == ".txt" || ext == ".vtp"))
-                            stale.push_back(n);
-                    }
-                    for (const auto& f : stale) {
-                        std::filesystem::remove(dir + f, ec);
-                        if (ec) throw InputError("--out-dir '" + w->out + "': cannot remove the previous " + f + " (" +
-                                                 ec.message() + ")");
-                    }
-                    checkpoints.remove_stale();
-                }
-                // The tables first, the summary last: a summary never lists a beta whose rows are not written yet.
-                write_file_atomic(dir + "sweep.csv", sweep.str());
-                write_file_atomic(dir + "pores.csv", pictures.pore_csv.str());
-                emit_json(summary(false), dir + "summary.json");
-            }
-            nlohmann::json r = summary(false);
-            r["interrupted"] = true;
-            r["provenance"] = provenance();
-            g_report = json_text(r, 2) + "\n";
-            std::ostringstream m;
-            m << "wet: interrupted during beta = " << betas[k] << " (" << k + 1 << " of " << betas.size() << "); "
-              << (k == 0 ? std::string("no beta finished")
-                         : std::to_string(k) + " finished beta(s) kept" +
-                               (dir.empty() ? std::string("") : " in " + w->out + " (summary.json: complete false, "
-                                                                                   "sweep.csv, pores.csv)") +
-                               " and reported on stdout")
-              << "\n";
-            if (checkpoints.enabled())
-                m << "wet: beta " << betas[k] << "'s relaxation continues from its last checkpoint, if one was written (every "
-                  << s.wet.checkpoint_seconds << " s): --start-state " << dir << "checkpoint_" << k
-                  << ".txt (the command is in checkpoint_" << k << ".json)\n";
-            g_message = m.str();
-        };
-        // A fresh run: fibernet scan runs this command once per sample in one process, and the last run's final
-        // write left the state held (kWriting), where hold() would wait for ever.
-        g_state = kRunning, g_pending = false;
-        hold();  // before the handler exists: nothing to report until checkpoint(0) has run
-        // Inside fibernet scan (its JSON captured) the scan's handler stays: an interrupt ends the scan after this
-        // sample, not the process in the middle of it.
-        std::optional<InterruptScope> interrupts;
-        if (!json_capture()) interrupts.emplace();
-        checkpoint(0);
-        release();
-        const auto t_betas = std::chrono::steady_clock::now();
-        for (size_t k = 0; k < betas.size(); ++k) {
-            opt.params.beta = betas[k];
-            if (!w->quiet) {
-                // ETA: the betas left at the mean time of those done (larger betas usually take longer: a floor).
-                char line[160];
-                if (k == 0) std::snprintf(line, sizeof line, "wet: beta = %g (1 of %zu)", betas[k], betas.size());
-                else
-                    std::snprintf(line, sizeof line, "wet: beta = %g (%zu of %zu), ETA %.0f s", betas[k], k + 1,
-                                  betas.size(), seconds_since(t_betas) / k * (betas.size() - k));
-                progress_line(line);
-            }
-            checkpoints.begin(k, betas[k]);
-            const WetRun r = run_wet(net, m, F, opt, k == 0 ? nullptr : &dry_state);
-            // An unconverged relaxation leaves its last state to continue from (never as a result: no state_<k>.txt).
-            const std::string left = r.wet.converged || opt.model != WetModel::Smooth
-                                         ? std::string()
-                                         : checkpoints.keep_last(r.wet.q, r.smooth.energy, r.smooth.grad_max);
-            hold();  // beta k is finished: from here until its files are written, an interrupt waits
-            if (!left.empty())
-                std::fprintf(stderr, "wet: beta = %g did not converge; its last state is %s%s (continue with "
-                             "--start-state)\n", betas[k], dir.c_str(), left.c_str());
-            if (!w->quiet) {
-                char line[400];
-                std::snprintf(line, sizeof line, "wet: beta = %g: %s, %zu bridges, %d solver iterations, %.1f s",
-                              betas[k], r.active.message.c_str(), r.active.bridges.size(), r.active.solver_iterations,
-                              r.active.seconds_solve + r.active.seconds_events);
-                progress_line(line);
-            }
-            if (k == 0) dry_state = r.dry;
-            const bool wet_good = r.dry.converged && r.wet.converged && r.active.stable;
-            const bool box_good = !opt.free_box.enabled || r.free_box.converged;
-            // Moduli asked for and not computed (a linear solve that failed) fail the run, as in `fibernet modulus`.
-            const bool moduli_good =
-                !opt.moduli || (std::isfinite(dry_state.shear_modulus) && std::isfinite(r.wet.shear_modulus));
-            const bool good = wet_good && box_good && moduli_good;
-            const char* bad = !wet_good ? "not_stable" : !box_good ? "free_box_not_converged" : "modulus_failed";
-            ok = ok && good;
-            sweep_row(sweep, betas[k], good ? "ok" : bad, r, dry_state, opt.free_box.enabled);
-            pictures.add(r, betas[k], k + 1 == betas.size(), m, F);
-            runs.push_back(run_json(betas[k], good ? "stable" : bad, r, dry_state, opt, s.solver.tol));
-            // Finished betas survive an interrupt: the tables and summary.json (complete: false) are rewritten
-            // (atomically) after each one; the pictures and stdout come at the end. After the last beta the handler
-            // stays held off: the results are complete.
-            // The wet equilibrium itself (model file, docs/formats.md): the fibers' state, exact; its bridges are in
-            // the summary's counts and the pictures.
-            if (!dir.empty() && r.wet.converged) {
-                runs.back()["state"] = write_state(dir, k, betas[k], m, F, r);
-                checkpoints.discard();  // state_<k>.txt supersedes them
-            }
-            if (!left.empty()) runs.back()["checkpoint"] = left;
-            if (k + 1 < betas.size()) checkpoint(k + 1), release();
-        }
-        const nlohmann::json j = summary(true);
-        if (!dir.empty()) {
-            write_file_atomic(dir + "sweep.csv", sweep.str());
-            write_file_atomic(dir + "pores.csv", pictures.pore_csv.str());
-            write_file_atomic(dir + "network.svg", network_svg(m, pictures.panels));
-            write_file_atomic(dir + "pores.svg", histogram_svg(pictures.hist_names, pictures.hist_values, "pore equivalent diameter (seed units)"));
-            emit_json(j, dir + "summary.json");
-        }
-        emit_json(j);
-        if (!ok) exit_code() = 1;
+        WetSweep sweep(read_inputs(*flags, *w, o_ms->count() > 0), *w, t_all);
+        if (!sweep.run()) exit_code() = 1;
     });
 }
 
