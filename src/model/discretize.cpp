@@ -30,6 +30,82 @@ struct Pin {
     double s;      // arc position in seed units
     int crossing;
 };
+
+// Fiber fib's nodes as arc positions (seed units) with the crossing each pins (-1: none), in arc order. Seed scheme:
+// regular nodes plus pins; even: ends plus pins, then subdivided to at most h. pins_f: the fiber's crosslinks in arc
+// order; coincident ones (a junction of three or more fibers) count once.
+std::vector<Pin> breakpoints(const Fiber& fib, const std::vector<Pin>& pins_f, const DiscretizationParams& p, double unit,
+                             double tol) {
+    const double len = fib.length * unit;
+    std::vector<Pin> pts;
+    std::vector<Pin> merged;  // pins with coincident ones removed
+    for (const auto& pin : pins_f)
+        if (merged.empty() || pin.s - merged.back().s > tol) merged.push_back(pin);
+    if (p.scheme == Scheme::Seed) {
+        const int nseg = std::max(1, static_cast<int>(std::lround(p.n_seg * fib.length)));
+        for (int k = 0; k <= nseg; ++k) pts.push_back({len * k / nseg, -1});
+    } else {
+        pts.push_back({0, -1});
+        pts.push_back({len, -1});
+    }
+    // A pin replaces a regular breakpoint it coincides with.
+    for (const auto& pin : merged) {
+        bool replaced = false;
+        for (auto& q : pts)
+            if (q.crossing < 0 && std::abs(q.s - pin.s) <= tol) q = {q.s, pin.crossing}, replaced = true;
+        if (!replaced) pts.push_back(pin);
+    }
+    for (double b : fib.breakpoints) {
+        bool present = false;
+        for (const auto& q : pts) present = present || std::abs(q.s - b * unit) <= tol;
+        if (!present) pts.push_back({b * unit, -1});
+    }
+    std::sort(pts.begin(), pts.end(), [](const Pin& a, const Pin& b) { return a.s < b.s; });
+    if (p.scheme == Scheme::Even) {
+        std::vector<Pin> fine{pts.front()};
+        for (size_t k = 1; k < pts.size(); ++k) {
+            const double a = pts[k - 1].s, b = pts[k].s;
+            const int n = std::max(1, static_cast<int>(std::ceil((b - a) / p.h - 1e-9)));
+            for (int i = 1; i < n; ++i) fine.push_back({a + (b - a) * i / n, -1});
+            fine.push_back(pts[k]);
+        }
+        pts.swap(fine);
+    }
+    if (p.trim_ends) {
+        auto first = std::find_if(pts.begin(), pts.end(), [](const Pin& q) { return q.crossing >= 0; });
+        auto last = std::find_if(pts.rbegin(), pts.rend(), [](const Pin& q) { return q.crossing >= 0; });
+        if (first == pts.end()) pts.clear();
+        else pts = std::vector<Pin>(first, last.base());
+    }
+    return pts;
+}
+
+// Fiber f's segments and hinges from its chain's nodes (m.chains[f]), unit direction u and the image of each node
+// occurrence (wraps).
+void add_elements(Model& m, int f, const Eigen::Vector2d& u, const std::vector<Eigen::Vector2i>& wraps) {
+    FiberChain& ch = m.chains[f];
+    for (size_t k = 0; k + 1 < ch.nodes.size(); ++k) {
+        Segment sg;
+        sg.i = ch.nodes[k], sg.j = ch.nodes[k + 1];
+        sg.shift = wraps[k + 1] - wraps[k];
+        sg.l0 = ch.s[k + 1] - ch.s[k];
+        sg.d0 = sg.l0 * u;  // exact rest vector: no cancellation of large wrapped coordinates
+        sg.fiber = f;
+        ch.segments.push_back(static_cast<int>(m.segments.size()));
+        m.segments.push_back(sg);
+    }
+    for (size_t k = 0; k + 2 < ch.nodes.size(); ++k) {
+        const Segment& a = m.segments[ch.segments[k]];
+        const Segment& b = m.segments[ch.segments[k + 1]];
+        Hinge hg;
+        hg.i = a.i, hg.j = a.j, hg.k = b.j;
+        hg.shift1 = a.shift, hg.shift2 = b.shift;
+        hg.lt0 = 0.5 * (a.l0 + b.l0);
+        hg.d10 = a.d0, hg.d20 = b.d0;
+        hg.fiber = f;
+        m.hinges.push_back(hg);
+    }
+}
 }  // namespace
 
 Model discretize(const Network& net, const DiscretizationParams& p) {
@@ -87,48 +163,7 @@ Model discretize(const Network& net, const DiscretizationParams& p) {
     m.chains.resize(nf);
     for (int f = 0; f < nf; ++f) {
         const Fiber& fib = net.fibers[f];
-        const double len = fib.length * unit;
-        // Breakpoints: (s, crossing or -1). Seed: regular nodes plus pins; even: ends plus pins, then subdivided.
-        std::vector<Pin> pts;
-        std::vector<Pin> merged;  // pins with coincident ones removed
-        for (const auto& pin : pins[f])
-            if (merged.empty() || pin.s - merged.back().s > tol) merged.push_back(pin);
-        if (p.scheme == Scheme::Seed) {
-            const int nseg = std::max(1, static_cast<int>(std::lround(p.n_seg * fib.length)));
-            for (int k = 0; k <= nseg; ++k) pts.push_back({len * k / nseg, -1});
-        } else {
-            pts.push_back({0, -1});
-            pts.push_back({len, -1});
-        }
-        // A pin replaces a regular breakpoint it coincides with.
-        for (const auto& pin : merged) {
-            bool replaced = false;
-            for (auto& q : pts)
-                if (q.crossing < 0 && std::abs(q.s - pin.s) <= tol) q = {q.s, pin.crossing}, replaced = true;
-            if (!replaced) pts.push_back(pin);
-        }
-        for (double b : fib.breakpoints) {
-            bool present = false;
-            for (const auto& q : pts) present = present || std::abs(q.s - b * unit) <= tol;
-            if (!present) pts.push_back({b * unit, -1});
-        }
-        std::sort(pts.begin(), pts.end(), [](const Pin& a, const Pin& b) { return a.s < b.s; });
-        if (p.scheme == Scheme::Even) {
-            std::vector<Pin> fine{pts.front()};
-            for (size_t k = 1; k < pts.size(); ++k) {
-                const double a = pts[k - 1].s, b = pts[k].s;
-                const int n = std::max(1, static_cast<int>(std::ceil((b - a) / p.h - 1e-9)));
-                for (int i = 1; i < n; ++i) fine.push_back({a + (b - a) * i / n, -1});
-                fine.push_back(pts[k]);
-            }
-            pts.swap(fine);
-        }
-        if (p.trim_ends) {
-            auto first = std::find_if(pts.begin(), pts.end(), [](const Pin& q) { return q.crossing >= 0; });
-            auto last = std::find_if(pts.rbegin(), pts.rend(), [](const Pin& q) { return q.crossing >= 0; });
-            if (first == pts.end()) pts.clear();
-            else pts = std::vector<Pin>(first, last.base());
-        }
+        const std::vector<Pin> pts = breakpoints(fib, pins[f], p, unit, tol);
         FiberChain& ch = m.chains[f];
         const Eigen::Vector2d u = fib.direction();
         std::vector<Eigen::Vector2i> wraps;
@@ -153,27 +188,7 @@ Model discretize(const Network& net, const DiscretizationParams& p) {
             const Eigen::Vector2d w = (P - x) / m.box.L;
             wraps.emplace_back(static_cast<int>(std::lround(w.x())), static_cast<int>(std::lround(w.y())));
         }
-        for (size_t k = 0; k + 1 < ch.nodes.size(); ++k) {
-            Segment sg;
-            sg.i = ch.nodes[k], sg.j = ch.nodes[k + 1];
-            sg.shift = wraps[k + 1] - wraps[k];
-            sg.l0 = ch.s[k + 1] - ch.s[k];
-            sg.d0 = sg.l0 * u;  // exact rest vector: no cancellation of large wrapped coordinates
-            sg.fiber = f;
-            ch.segments.push_back(static_cast<int>(m.segments.size()));
-            m.segments.push_back(sg);
-        }
-        for (size_t k = 0; k + 2 < ch.nodes.size(); ++k) {
-            const Segment& a = m.segments[ch.segments[k]];
-            const Segment& b = m.segments[ch.segments[k + 1]];
-            Hinge hg;
-            hg.i = a.i, hg.j = a.j, hg.k = b.j;
-            hg.shift1 = a.shift, hg.shift2 = b.shift;
-            hg.lt0 = 0.5 * (a.l0 + b.l0);
-            hg.d10 = a.d0, hg.d20 = b.d0;
-            hg.fiber = f;
-            m.hinges.push_back(hg);
-        }
+        add_elements(m, f, u, wraps);
     }
     std::vector<int> supernode_of_node(pos.size() / 2, -1);
     for (size_t i = 0; i < m.supernodes.size(); ++i) supernode_of_node[m.supernodes[i].node] = static_cast<int>(i);
