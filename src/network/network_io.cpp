@@ -92,9 +92,9 @@ struct LineReader {
 };
 }  // namespace
 
-Network read_network(std::istream& is, const std::string& source) {
-    LineReader r{is, source, 0, {}};
-    Network net;
+namespace {
+// The header and the box line.
+void read_box(LineReader& r, Network& net) {
     {
         auto ss = r.next("header 'fibernet-network 1'");
         r.keyword(ss, "fibernet-network");
@@ -112,6 +112,10 @@ Network read_network(std::istream& is, const std::string& source) {
         net.periodic = kind == "periodic";
         r.expect_end(ss);
     }
+}
+
+// The optional meta line and the fibers; returns their count.
+long read_fibers(LineReader& r, Network& net) {
     auto ss = r.next("'meta ...' or 'fibers N'");
     std::string kw;
     ss >> kw;
@@ -151,57 +155,64 @@ Network read_network(std::istream& is, const std::string& source) {
             r.fail("fiber length = " + show(f.length) + " must be < L/2 = " + show(net.L / 2) + " in a periodic box");
         r.expect_end(ls);
     }
-    {
-        auto cs = r.next("'crossings M'");
-        r.keyword(cs, "crossings");
-        const long nc = r.integer(cs, "crossing count", 0, 1000000000);
-        r.expect_end(cs);
-        net.crossings.clear();
-        net.crossings.reserve(static_cast<size_t>(std::min(nc, kReserveAtMost)));
-        // Two straight fibers cross at most once per periodic image: a repeated line would count twice. Found by
-        // sorting (fiber pair, image, line) keys after reading (a map node per crossing cost ~200 MB at 2.5e6).
-        std::vector<std::pair<std::array<int, 4>, std::array<long, 2>>> keys;  // key, (crossing, line)
-        keys.reserve(static_cast<size_t>(std::min(nc, kReserveAtMost)));
-        for (long k = 0; k < nc; ++k) {
-            auto ls = r.next("crossing " + std::to_string(k));
-            Crossing& c = net.crossings.emplace_back();
-            c.f1 = static_cast<int>(r.integer(ls, "crossing f1", 0, nf - 1));
-            c.f2 = static_cast<int>(r.integer(ls, "crossing f2", 0, nf - 1));
-            if (c.f1 == c.f2) r.fail("crossing joins fiber " + std::to_string(c.f1) + " to itself");
-            c.s1 = r.number(ls, "crossing s1");
-            c.s2 = r.number(ls, "crossing s2");
-            if (c.s1 < 0 || c.s1 > net.fibers[c.f1].length)
-                r.fail("crossing s1 = " + show(c.s1) + " lies outside fiber " + std::to_string(c.f1));
-            if (c.s2 < 0 || c.s2 > net.fibers[c.f2].length)
-                r.fail("crossing s2 = " + show(c.s2) + " lies outside fiber " + std::to_string(c.f2));
-            c.image.x() = static_cast<int>(r.integer(ls, "crossing image x", -1000000, 1000000));
-            c.image.y() = static_cast<int>(r.integer(ls, "crossing image y", -1000000, 1000000));
-            if (!net.periodic && (c.image.x() != 0 || c.image.y() != 0))
-                r.fail("crossing image must be 0 0 in an open box");
-            c.crosslink = r.integer(ls, "crossing crosslink flag", 0, 1) == 1;
-            r.expect_end(ls);
-            // The two arc positions must name the same point (within round-off of the geometry).
-            const Eigen::Vector2d p1 = net.fibers[c.f1].point(c.s1);
-            const Eigen::Vector2d p2 = net.fibers[c.f2].point(c.s2) + net.L * c.image.cast<double>();
-            if ((p1 - p2).norm() > 1e-8 * std::max(1.0, net.L))
-                r.fail("crossing " + std::to_string(k) + " points on fibers " + std::to_string(c.f1) + " and " +
-                       std::to_string(c.f2) + " are " + show((p1 - p2).norm()) + " apart (must coincide)");
-            keys.push_back({c.f1 < c.f2 ? std::array<int, 4>{c.f1, c.f2, c.image.x(), c.image.y()}
-                                        : std::array<int, 4>{c.f2, c.f1, -c.image.x(), -c.image.y()},
-                            {k, static_cast<long>(r.line)}});
-        }
-        std::sort(keys.begin(), keys.end());
-        // Of all repeats, the one whose later line comes first in the file.
-        auto rep = keys.end();
-        for (auto it = keys.begin(); it + 1 < keys.end(); ++it)
-            if (it->first == (it + 1)->first && (rep == keys.end() || (it + 1)->second[0] < (rep + 1)->second[0])) rep = it;
-        if (rep != keys.end()) {
-            const long first = rep->second[0], later = std::next(rep)->second[0];
-            r.line = static_cast<int>(std::next(rep)->second[1]);  // the message names the later line
-            r.fail("crossing " + std::to_string(later) + " repeats crossing " + std::to_string(first) + " (fibers " +
-                   std::to_string(rep->first[0]) + " and " + std::to_string(rep->first[1]) + ")");
-        }
+    return nf;
+}
+
+// The crossings of the nf fibers, each checked against its fibers and for repeats.
+void read_crossings(LineReader& r, Network& net, long nf) {
+    auto cs = r.next("'crossings M'");
+    r.keyword(cs, "crossings");
+    const long nc = r.integer(cs, "crossing count", 0, 1000000000);
+    r.expect_end(cs);
+    net.crossings.clear();
+    net.crossings.reserve(static_cast<size_t>(std::min(nc, kReserveAtMost)));
+    // Two straight fibers cross at most once per periodic image: a repeated line would count twice. Found by
+    // sorting (fiber pair, image, line) keys after reading (a map node per crossing cost ~200 MB at 2.5e6).
+    std::vector<std::pair<std::array<int, 4>, std::array<long, 2>>> keys;  // key, (crossing, line)
+    keys.reserve(static_cast<size_t>(std::min(nc, kReserveAtMost)));
+    for (long k = 0; k < nc; ++k) {
+        auto ls = r.next("crossing " + std::to_string(k));
+        Crossing& c = net.crossings.emplace_back();
+        c.f1 = static_cast<int>(r.integer(ls, "crossing f1", 0, nf - 1));
+        c.f2 = static_cast<int>(r.integer(ls, "crossing f2", 0, nf - 1));
+        if (c.f1 == c.f2) r.fail("crossing joins fiber " + std::to_string(c.f1) + " to itself");
+        c.s1 = r.number(ls, "crossing s1");
+        c.s2 = r.number(ls, "crossing s2");
+        if (c.s1 < 0 || c.s1 > net.fibers[c.f1].length)
+            r.fail("crossing s1 = " + show(c.s1) + " lies outside fiber " + std::to_string(c.f1));
+        if (c.s2 < 0 || c.s2 > net.fibers[c.f2].length)
+            r.fail("crossing s2 = " + show(c.s2) + " lies outside fiber " + std::to_string(c.f2));
+        c.image.x() = static_cast<int>(r.integer(ls, "crossing image x", -1000000, 1000000));
+        c.image.y() = static_cast<int>(r.integer(ls, "crossing image y", -1000000, 1000000));
+        if (!net.periodic && (c.image.x() != 0 || c.image.y() != 0))
+            r.fail("crossing image must be 0 0 in an open box");
+        c.crosslink = r.integer(ls, "crossing crosslink flag", 0, 1) == 1;
+        r.expect_end(ls);
+        // The two arc positions must name the same point (within round-off of the geometry).
+        const Eigen::Vector2d p1 = net.fibers[c.f1].point(c.s1);
+        const Eigen::Vector2d p2 = net.fibers[c.f2].point(c.s2) + net.L * c.image.cast<double>();
+        if ((p1 - p2).norm() > 1e-8 * std::max(1.0, net.L))
+            r.fail("crossing " + std::to_string(k) + " points on fibers " + std::to_string(c.f1) + " and " +
+                   std::to_string(c.f2) + " are " + show((p1 - p2).norm()) + " apart (must coincide)");
+        keys.push_back({c.f1 < c.f2 ? std::array<int, 4>{c.f1, c.f2, c.image.x(), c.image.y()}
+                                    : std::array<int, 4>{c.f2, c.f1, -c.image.x(), -c.image.y()},
+                        {k, static_cast<long>(r.line)}});
     }
+    std::sort(keys.begin(), keys.end());
+    // Of all repeats, the one whose later line comes first in the file.
+    auto rep = keys.end();
+    for (auto it = keys.begin(); it + 1 < keys.end(); ++it)
+        if (it->first == (it + 1)->first && (rep == keys.end() || (it + 1)->second[0] < (rep + 1)->second[0])) rep = it;
+    if (rep != keys.end()) {
+        const long first = rep->second[0], later = std::next(rep)->second[0];
+        r.line = static_cast<int>(std::next(rep)->second[1]);  // the message names the later line
+        r.fail("crossing " + std::to_string(later) + " repeats crossing " + std::to_string(first) + " (fibers " +
+               std::to_string(rep->first[0]) + " and " + std::to_string(rep->first[1]) + ")");
+    }
+}
+
+// The optional breakpoint blocks after the crossings.
+void read_breakpoints(std::istream& is, LineReader& r, Network& net, long nf) {
     std::string rest;
     while (std::getline(is, rest)) {
         ++r.line;
@@ -224,6 +235,16 @@ Network read_network(std::istream& is, const std::string& source) {
             net.fibers[f].breakpoints.push_back(s);
         }
     }
+}
+}  // namespace
+
+Network read_network(std::istream& is, const std::string& source) {
+    LineReader r{is, source, 0, {}};
+    Network net;
+    read_box(r, net);
+    const long nf = read_fibers(r, net);
+    read_crossings(r, net, nf);
+    read_breakpoints(is, r, net, nf);
     return net;
 }
 
