@@ -360,6 +360,41 @@ ComovingRhs comoving_rhs(const Eigen::SparseMatrix<double>& H, const std::vector
     }
     return r;
 }
+// D = |diag H| floored at 1e-12 of its median, so that a coordinate without stiffness still gets a shift
+// (relaxed_moduli's Jacobi-scaled shift H + delta D).
+std::vector<double> shift_scales(const Eigen::SparseMatrix<double>& H) {
+    const int n = static_cast<int>(H.rows());
+    std::vector<double> diag(n);
+    for (int j = 0; j < n; ++j) diag[j] = std::abs(H.coeff(j, j));
+    std::vector<double> sorted = diag;
+    std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+    const double d_floor = std::max(1e-12 * sorted[n / 2], std::numeric_limits<double>::min());
+    for (double& d : diag) d = std::max(d, d_floor);
+    return diag;
+}
+
+// One factorization of Hd = H + delta D into llt, delta from rel grown 100x at a time (up to 8 tries) while round-off
+// makes the (PSD, singular) H fail to factor. False if none factored.
+bool factor_shifted(LinearSolver& llt, const Eigen::SparseMatrix<double>& H, const std::vector<double>& diag, double rel,
+                    Eigen::SparseMatrix<double>& Hd, ModuliInfo& inf) {
+    auto t0 = Clock::now();
+    if (!llt.analyzed()) llt.analyze(H);  // a shared wrapper of another pattern is re-analyzed by factorize()
+    inf.seconds_factorization += since(t0);
+    bool factored = false;
+    double delta = rel;
+    const int n = static_cast<int>(H.rows());
+    for (int k = 0; k < 8 && !factored; ++k, delta *= 100) {
+        t0 = Clock::now();
+        for (int j = 0; j < n; ++j) Hd.coeffRef(j, j) = H.coeff(j, j) + delta * diag[j];
+        factored = llt.factorize(Hd, 0.0);
+        inf.seconds_one_factorization = since(t0);
+        inf.seconds_factorization += inf.seconds_one_factorization;
+        ++inf.factorizations;
+        if (factored) inf.delta = delta;
+        inf.shift_grown = inf.shift_grown || (factored && k > 0);  // in either attempt
+    }
+    return factored;
+}
 }  // namespace
 
 std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const std::vector<StrainTerms>& terms,
@@ -388,12 +423,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
     // median |diagonal| failed on the seed scheme's 1e-5 segments (stiffness 1e5 the median) and had to grow to 1e-4,
     // which left the CG hundreds of soft modes (L = 40: modulus_failed; now 136 steps, docs/moduli.md). D is floored
     // at 1e-12 of the median so that a coordinate without stiffness still gets a shift.
-    std::vector<double> diag(n);
-    for (int j = 0; j < n; ++j) diag[j] = std::abs(H.coeff(j, j));
-    std::vector<double> sorted = diag;
-    std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
-    const double d_floor = std::max(1e-12 * sorted[n / 2], std::numeric_limits<double>::min());
-    for (double& d : diag) d = std::max(d, d_floor);
+    const std::vector<double> diag = shift_scales(H);
     // The right-hand sides in comoving coordinates, the same for both shift scales below.
     auto t0 = Clock::now();
     const auto Hs = H.selfadjointView<Eigen::Upper>();
@@ -408,23 +438,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
     Eigen::SparseMatrix<double> Hd = H;  // H + delta D
     auto attempt = [&](double rel) -> bool {
         out = base;
-        // One factorization of H + delta D; grow delta if round-off makes the (PSD, singular) H fail to factor.
-        t0 = Clock::now();
-        if (!llt.analyzed()) llt.analyze(H);  // a shared wrapper of another pattern is re-analyzed by factorize()
-        inf.seconds_factorization += since(t0);
-        bool factored = false;
-        double delta = rel;
-        for (int k = 0; k < 8 && !factored; ++k, delta *= 100) {
-            t0 = Clock::now();
-            for (int j = 0; j < n; ++j) Hd.coeffRef(j, j) = H.coeff(j, j) + delta * diag[j];
-            factored = llt.factorize(Hd, 0.0);
-            inf.seconds_one_factorization = since(t0);
-            inf.seconds_factorization += inf.seconds_one_factorization;
-            ++inf.factorizations;
-            if (factored) inf.delta = delta;
-            inf.shift_grown = inf.shift_grown || (factored && k > 0);  // in either attempt
-        }
-        if (!factored) {
+        if (!factor_shifted(llt, H, diag, rel, Hd, inf)) {
             inf.message = "H + delta |diag H| is not positive definite up to delta = 1e2: not a stable equilibrium";
             return false;
         }
