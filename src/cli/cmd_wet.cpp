@@ -725,8 +725,9 @@ private:
         }
         if (k == 0) dry_state_ = r.dry;
         const char* status = run_status(r);
-        ok_ = ok_ && std::string(status) == "stable";
-        sweep_row(sweep_, beta, std::string(status) == "stable" ? "ok" : status, r, dry_state_, opt.free_box.enabled);
+        const bool good = std::string(status) == "stable";
+        ok_ = ok_ && good;
+        sweep_row(sweep_, beta, good ? "ok" : status, r, dry_state_, opt.free_box.enabled);
         pictures_.add(r, beta, k + 1 == in_.betas.size(), m_, F_);
         runs_.push_back(run_json(beta, status, r, dry_state_, opt, in_.s.solver.tol));
         // The wet equilibrium itself (model file, docs/formats.md): the fibers' state, exact; its bridges are in the
