@@ -69,15 +69,27 @@ void solve_following(SmoothWetEnergy& W, Solver& solver, Eigen::VectorXd& q, con
     R.message = m + R.last.message;
 }
 
+// The relaxation's message when a solver's own max_iter, the budget of all its rounds, is spent.
+void out_of_budget(SmoothRelaxResult& R, int max_iter) {
+    --R.rounds;  // the rounds that ran
+    char m[200];
+    std::snprintf(m, sizeof m, "no equilibrium after %d solver iterations (the solver's max_iter = %d, over %d rounds), "
+                  "max|g| = %.3g", R.iterations, max_iter, R.rounds, R.grad_max);
+    R.message = m;
+}
+
 // Rounds of at most round_iterations solver iterations with the pattern fixed in each, rebuilt between them where
-// it no longer covers the state: for solvers that need a fixed pattern.
+// it no longer covers the state: for solvers that need a fixed pattern. A solver whose iterations are not Newton
+// steps has its own max_iter as the budget of all its rounds together, as a user who sets it expects.
 void solve_in_rounds(SmoothWetEnergy& W, Solver& solver, Eigen::VectorXd& q, const SmoothRelaxOptions& opt,
                      const SolverOptions& base, SmoothRelaxResult& R) {
     const SolverCapabilities caps = solver.capabilities();
+    const bool budget = !caps.newton_steps;
     const int cap = caps.newton_steps && opt.round_iterations > 0 ? opt.round_iterations : base.max_iter;
     for (R.rounds = 1; R.rounds <= opt.max_rounds; ++R.rounds) {
+        if (budget && R.iterations >= base.max_iter) return out_of_budget(R, base.max_iter);
         SolverOptions& o = solver.options();
-        o.max_iter = cap;
+        o.max_iter = budget ? base.max_iter - R.iterations : cap;
         o.warm_start = base.warm_start || (R.rounds > 1 && caps.warm_start);
         configure(o, base, caps, W, opt);
         add(R, solver.minimize(W, q));

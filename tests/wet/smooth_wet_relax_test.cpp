@@ -206,3 +206,25 @@ TEST_CASE("smooth wet relaxation: a relaxation out of budget is reported unconve
     CHECK(r.last.status == SolveStatus::IterationLimit);
     CHECK(solver->options().max_iter == 200);  // the solver's options are restored
 }
+
+TEST_CASE("smooth wet relaxation: a first-order solver's max_iter bounds the whole relaxation", "[wet][smooth]") {
+    // Rounds exist so that a solver that uses the Hessian sees a pattern that covers the state; a solver whose
+    // iterations are not Newton steps gets its own max_iter as the budget of all its rounds together (before: its
+    // max_iter in every round, up to max_rounds of them, so `--solver lbfgs --max-iter 5000` ran 1e5 iterations).
+    const Model m = model_of(mikado(2.5, 3, 0.5, 5), 6);
+    NetworkEnergy e(m);
+    Eigen::VectorXd q = e.dofs(m.x);
+    SmoothWetEnergy W(e, Eigen::Matrix2d::Identity(), smooth(0.5), {}, q);
+    SolverOptions so;
+    so.tol = 1e-10, so.max_iter = 30;
+    auto lbfgs = make_solver("lbfgs", so);
+    SmoothRelaxOptions o;
+    o.max_rounds = 200;
+    const SmoothRelaxResult r = relax_smooth_wet(W, *lbfgs, q, o);
+    INFO(r.message << " after " << r.rounds << " rounds, " << r.iterations << " iterations");
+    CHECK(!r.converged);
+    CHECK(r.iterations <= 30);
+    CHECK(r.message.find("max_iter = 30") != std::string::npos);
+    CHECK(r.last.status == SolveStatus::IterationLimit);
+    CHECK(lbfgs->options().max_iter == 30);  // the solver's options are restored
+}

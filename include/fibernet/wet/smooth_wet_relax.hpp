@@ -6,9 +6,10 @@
 //   - A solver that follows a changing Hessian pattern (SolverCapabilities::follows_pattern: Newton) minimizes it in
 //     one solve; the energy rebuilds the pattern at a Hessian that needs it (SmoothWetEnergy::follow_pattern), and
 //     the solver analyzes the new one. The budget is max_rounds x round_iterations iterations.
-//   - Any other solver runs rounds of at most `round_iterations` iterations (its own max_iter for solvers whose
-//     iterations are not Newton steps), the pattern fixed in each and rebuilt between them where it no longer covers
-//     the state (the list was rebuilt since, or a non-zero pair fell outside it).
+//   - Any other solver runs rounds of at most `round_iterations` iterations, the pattern fixed in each and rebuilt
+//     between them where it no longer covers the state (the list was rebuilt since, or a non-zero pair fell outside
+//     it). A solver whose iterations are not Newton steps (L-BFGS, CG, FIRE, NLopt, Ipopt) has its own max_iter as
+//     the budget of all its rounds together.
 #include <Eigen/Core>
 #include <functional>
 #include <string>
@@ -20,7 +21,7 @@ namespace fibernet {
 
 struct SmoothRelaxOptions {
     // Solver iterations per round for solvers whose iterations are Newton steps (SolverCapabilities::newton_steps;
-    // others get their own max_iter per round); 0: rounds are not cut.
+    // others share their own max_iter over all rounds); 0: rounds are not cut.
     int round_iterations = 20;
     int max_rounds = 200;
     bool progress = false;  // a line per round on stderr (following: the solver's once-a-second line)
