@@ -73,8 +73,8 @@ void solve_following(SmoothWetEnergy& W, Solver& solver, Eigen::VectorXd& q, con
 void out_of_budget(SmoothRelaxResult& R, int max_iter) {
     --R.rounds;  // the rounds that ran
     char m[200];
-    std::snprintf(m, sizeof m, "no equilibrium after %d solver iterations (the solver's max_iter = %d, over %d rounds), "
-                  "max|g| = %.3g", R.iterations, max_iter, R.rounds, R.grad_max);
+    std::snprintf(m, sizeof m, "no equilibrium after %d solver iterations (the solver's max_iter = %d, in %d round%s), "
+                  "max|g| = %.3g", R.iterations, max_iter, R.rounds, R.rounds == 1 ? "" : "s", R.grad_max);
     R.message = m;
 }
 
