@@ -224,7 +224,10 @@ TEST_CASE("smooth wet relaxation: a first-order solver's max_iter bounds the who
     INFO(r.message << " after " << r.rounds << " rounds, " << r.iterations << " iterations");
     CHECK(!r.converged);
     CHECK(r.iterations <= 30);
-    CHECK(r.message.find("max_iter = 30") != std::string::npos);
+    // Spent in the first round either way; whether the pattern was out of date after it (so that a second round was
+    // due) depends on the path, so either message may come.
+    CHECK((r.message.find("max_iter = 30") != std::string::npos ||
+           r.message.find("iteration limit 30") != std::string::npos));
     CHECK(r.last.status == SolveStatus::IterationLimit);
     CHECK(lbfgs->options().max_iter == 30);  // the solver's options are restored
 }
