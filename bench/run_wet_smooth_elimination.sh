@@ -2,12 +2,13 @@
 # Newton with and without nonlinear elimination on the smooth wet model (issues 22 and 23; docs/wet.md "Nonlinear
 # elimination on the smooth model", docs/benchmarks.md): per case a Mikado network of N = q L^2 fibers (pl = 0.5),
 # `fibernet wet --wet-model smooth --bundle-partners 2` at one beta without moduli, on one thread, once plain and once
-# with --wet-eliminate. One row per run: status, global factorizations (the solver's iterations: one factorization
+# with --wet-eliminate (and with the Schwarz sweep, --wet-schwarz, when METHODS names it). One row per run: status, global factorizations (the solver's iterations: one factorization
 # each), local solves and their iterations, neighbour-list builds, the wet energy and its capillary part, max|g| of the
 # whole energy at the end, and seconds of wet solving.
 #   bench/run_wet_smooth_elimination.sh > rows.tsv
 # Environment: FIBERNET (default build/fibernet), CASES ("L Q SEED BETA" per case, ';'-separated; default 100, 300 and
-# 1000 fibers at beta = 0.01 and the 128-fiber beta = 1 example), METHODS ("plain eliminate"), FLAGS (extra flags of
+# 1000 fibers at beta = 0.01 and the 128-fiber beta = 1 example), METHODS ("plain eliminate", or any of plain, eliminate,
+# schwarz), SCHWARZ (the Schwarz sweep's block size, default 500 coordinates), FLAGS (extra flags of
 # every run, e.g. "--wet-eliminate-hops 4"), KEEP (a directory: each run's JSON and its -v progress log are kept there as
 # N-BETA-METHOD.json and .log, for the time split in the JSON's smooth.seconds_solver and a long run's progress).
 set -euo pipefail
@@ -25,6 +26,7 @@ for c in "${case_list[@]}"; do
     for method in ${METHODS:-plain eliminate}; do
         flags=()
         [ "$method" = eliminate ] && flags=(--wet-eliminate)
+        [ "$method" = schwarz ] && flags=(--wet-schwarz "${SCHWARZ:-500}")
         rc=0
         log=/dev/stderr  # errors stay visible; -q keeps progress off
         talk=-q

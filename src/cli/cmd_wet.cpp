@@ -258,6 +258,11 @@ WetRunOptions run_options(const Scene& s, const WetFlags& w, std::string& law_te
     opt.solver_options.tol = s.solver.tol, opt.solver_options.max_iter = s.solver.max_iter;
     opt.solver_options.eliminate = s.wet.newton_eliminate;
     if (s.wet.model == "smooth") opt.solver_options.elimination.hops = s.wet.eliminate_hops;
+    if (s.wet.schwarz_block > 0) {
+        opt.solver_options.eliminate = true;
+        opt.solver_options.elimination.block = s.wet.schwarz_block;
+        opt.solver_options.elimination.overlap = s.wet.schwarz_overlap;
+    }
     opt.solver_options.verbose = w.verbose;
     opt.active_set.verbose = w.verbose || !w.quiet;
     opt.active_set.max_rounds = s.wet.max_rounds;
@@ -628,7 +633,12 @@ private:
                               {"strain", to_string(s.strain)},
                               {"gamma", s.gamma},
                               {"solver", {{"name", s.solver.name}, {"tol", s.solver.tol}, {"max_iter", s.solver.max_iter},
-                                          {"eliminate", s.wet.newton_eliminate},
+                                          {"eliminate", s.wet.newton_eliminate || s.wet.schwarz_block > 0},
+                                          {"schwarz_block", s.wet.schwarz_block > 0 ? nlohmann::json(s.wet.schwarz_block)
+                                                                                    : nlohmann::json()},
+                                          {"schwarz_overlap", s.wet.schwarz_block > 0
+                                                                  ? nlohmann::json(s.wet.schwarz_overlap)
+                                                                  : nlohmann::json()},
                                           {"eliminate_hops", s.wet.newton_eliminate && s.wet.model == "smooth"
                                                                  ? nlohmann::json(s.wet.eliminate_hops)
                                                                  : nlohmann::json()}}},

@@ -35,6 +35,9 @@ void Scene::check() const {
     if (wet.newton_eliminate && !solver_capabilities(solver.name).eliminate)
         throw InputError(source + ": [wet].newton_eliminate = true needs a solver with nonlinear elimination (newton); "
                          "solver is '" + solver.name + "'");
+    if (wet.schwarz_block > 0 && !solver_capabilities(solver.name).eliminate)
+        throw InputError(source + ": [wet].schwarz_block = " + std::to_string(wet.schwarz_block) +
+                         " needs a solver with nonlinear elimination (newton); solver is '" + solver.name + "'");
     check_beta(wet.beta, source, "[wet].beta");
     // The law file last: a --law flag replaces the scene's before any file is opened.
     if (!wet.law.empty()) {
@@ -72,6 +75,8 @@ void Scene::check_values() const {
     check_value(wet.local_threshold > 0 && wet.local_threshold < 1, wet.local_threshold, source, "[wet].local_threshold",
                 "must lie in (0, 1)");
     check_value(wet.eliminate_hops >= 0, wet.eliminate_hops, source, "[wet].eliminate_hops", "must be >= 0");
+    check_value(wet.schwarz_block >= 0, wet.schwarz_block, source, "[wet].schwarz_block", "must be >= 0 (0: off)");
+    check_value(wet.schwarz_overlap >= 0, wet.schwarz_overlap, source, "[wet].schwarz_overlap", "must be >= 0");
     check_value(wet.local_hops >= 0, wet.local_hops, source, "[wet].local_hops", "must be >= 0");
     check_value(wet.bundle_partners >= 0, wet.bundle_partners, source, "[wet].bundle_partners", "must be >= 0 (0: no cap)");
     if (wet.model != "events" && wet.model != "smooth")

@@ -142,6 +142,14 @@ std::vector<SceneOption> declare() {
                 "smooth model with --wet-eliminate: coordinate hops the hot set grows by before its local solves "
                 "(the event model keeps the dry default, 16; docs/wet.md)",
                 [](Scene& s) -> int& { return s.wet.eliminate_hops; }));
+    add(integer("wet", "schwarz_block", "--wet-schwarz",
+                "Newton's Schwarz sweep in the wet relaxation: before each global step, every coordinate to local "
+                "equilibrium in connected blocks of about this many coordinates (0: off; implies --wet-eliminate; "
+                "docs/wet.md)",
+                [](Scene& s) -> int& { return s.wet.schwarz_block; }));
+    add(integer("wet", "schwarz_overlap", "--wet-schwarz-overlap",
+                "with --wet-schwarz: coordinate hops each block is grown by",
+                [](Scene& s) -> int& { return s.wet.schwarz_overlap; }));
     add(real("wet", "local_fraction", "", "local rounds: largest part of the coordinates",
              [](Scene& s) -> double& { return s.wet.local_fraction; }));
     add(real("wet", "local_threshold", "", "local rounds: hot where |g| > threshold x max|g|",

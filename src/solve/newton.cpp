@@ -201,7 +201,7 @@ private:
         if (!ne_ || !ne_->select(g_)) return Step::again();
         local_tol_ = std::max(opt_.tol, opt_.elimination.local_rtol * gmax_);
         ne_->eliminate(run.objective(), q, local_tol_, time_left(run));
-        eliminating_ = true;
+        eliminating_ = ne_->at_trial_points();
         const auto ta = Clock::now();
         fq_ = run.objective().hessian(q, g_, H_, projected_);
         run.result().timings.assembly += since(ta);

@@ -17,6 +17,8 @@ void EliminationOptions::check(const std::string& where) const {
                 "must lie in (0, 1]");
     check_value(local_rtol > 0 && local_rtol < 1, local_rtol, where, "elimination.local_rtol", "must lie in (0, 1)");
     check_value(local_max_iter >= 1, local_max_iter, where, "elimination.local_max_iter", "must be >= 1");
+    check_value(block >= 0, block, where, "elimination.block", "must be >= 0 (0: the hot places only)");
+    check_value(overlap >= 0, overlap, where, "elimination.overlap", "must be >= 0");
 }
 
 NonlinearElimination::NonlinearElimination(const Eigen::SparseMatrix<double>& P, EliminationOptions opt, bool median_floor,
@@ -41,6 +43,57 @@ void NonlinearElimination::set_pattern(const Eigen::SparseMatrix<double>& P) {
             const int i = P.innerIndexPtr()[p];
             if (i != j) adj_[fill[i]++] = j, adj_[fill[j]++] = i;
         }
+    if (opt_.block > 0) partition();
+}
+
+void NonlinearElimination::partition() {
+    const int n = static_cast<int>(adj_start_.size()) - 1;
+    const int B = opt_.block;
+    // Blocks grown breadth first from the lowest coordinate not yet taken, up to B coordinates each.
+    std::vector<int> owner(n, -1);
+    std::vector<std::vector<int>> blocks;
+    for (int s = 0; s < n; ++s) {
+        if (owner[s] >= 0) continue;
+        const int b = static_cast<int>(blocks.size());
+        std::vector<int> part{s};
+        owner[s] = b;
+        for (size_t k = 0; k < part.size() && static_cast<int>(part.size()) < B; ++k)
+            for (int p = adj_start_[part[k]]; p < adj_start_[part[k] + 1] && static_cast<int>(part.size()) < B; ++p)
+                if (owner[adj_[p]] < 0) owner[adj_[p]] = b, part.push_back(adj_[p]);
+        blocks.push_back(std::move(part));
+    }
+    // A block that ran out of room (enclosed by blocks grown before it) joins a neighbouring block: many tiny blocks
+    // would each cost a local solve's setup for little work.
+    for (size_t b = 0; b < blocks.size(); ++b) {
+        if (4 * static_cast<int>(blocks[b].size()) >= B) continue;
+        int to = -1;
+        for (int i : blocks[b])
+            for (int p = adj_start_[i]; p < adj_start_[i + 1] && to < 0; ++p)
+                if (owner[adj_[p]] != static_cast<int>(b)) to = owner[adj_[p]];
+        if (to < 0) continue;  // a component of its own
+        for (int i : blocks[b]) owner[i] = to;
+        blocks[to].insert(blocks[to].end(), blocks[b].begin(), blocks[b].end());
+        blocks[b].clear();
+    }
+    // Each block grown by `overlap` hops.
+    blocks_.clear();
+    std::vector<char> in(n, 0);
+    std::vector<int> frontier, next;
+    for (std::vector<int>& part : blocks) {
+        if (part.empty()) continue;
+        for (int i : part) in[i] = 1;
+        frontier = part;
+        for (int h = 0; h < opt_.overlap && !frontier.empty(); ++h) {
+            next.clear();
+            for (int i : frontier)
+                for (int p = adj_start_[i]; p < adj_start_[i + 1]; ++p)
+                    if (!in[adj_[p]]) in[adj_[p]] = 1, next.push_back(adj_[p]), part.push_back(adj_[p]);
+            frontier.swap(next);
+        }
+        for (int i : part) in[i] = 0;
+        std::sort(part.begin(), part.end());
+        blocks_.push_back(std::move(part));
+    }
 }
 
 bool NonlinearElimination::select(const Eigen::VectorXd& g) {
@@ -49,6 +102,12 @@ bool NonlinearElimination::select(const Eigen::VectorXd& g) {
     const int n = static_cast<int>(g.size());
     const double gmax = n > 0 ? g.lpNorm<Eigen::Infinity>() : 0.0;
     if (!(gmax > 0)) return false;
+    if (opt_.block > 0) {
+        parts_ = blocks_;
+        selected_ = n;
+        ++counts_.selections;
+        return true;
+    }
     // The hot coordinates, grown breadth first `hops` times.
     std::vector<char> in(n, 0);
     std::vector<int> frontier, next;

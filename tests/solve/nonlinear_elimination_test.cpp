@@ -152,6 +152,74 @@ TEST_CASE("elimination options out of range are refused by name", "[solve][elimi
     CHECK(refused(o, "elimination.local_rtol = 1"));
     o = {}, o.local_max_iter = 0;
     CHECK(refused(o, "elimination.local_max_iter = 0"));
+    o = {}, o.block = -3;
+    CHECK(refused(o, "elimination.block = -3"));
+    o = {}, o.overlap = -1;
+    CHECK(refused(o, "elimination.overlap = -1"));
+}
+
+TEST_CASE("the Schwarz sweep's blocks cover every coordinate, connected, grown by the overlap", "[solve][elimination]") {
+    // A chain of 10 coordinates (tridiagonal pattern).
+    const int n = 10;
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < n; ++i) {
+        t.emplace_back(i, i, 0.0);
+        if (i + 1 < n) t.emplace_back(i, i + 1, 0.0);
+    }
+    Eigen::SparseMatrix<double> P(n, n);
+    P.setFromTriplets(t.begin(), t.end());
+    EliminationOptions o;
+    o.block = 4, o.overlap = 0;
+    NonlinearElimination ne(P, o);
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+    CHECK_FALSE(ne.select(g));  // nothing to relax
+    g[0] = 1;                   // the blocks do not depend on where the gradient is
+    REQUIRE(ne.select(g));
+    CHECK(ne.parts() == std::vector<std::vector<int>>{{0, 1, 2, 3}, {4, 5, 6, 7}, {8, 9}});
+    CHECK(ne.coordinates() == n);
+    o.overlap = 1;
+    NonlinearElimination over(P, o);
+    REQUIRE(over.select(g));
+    CHECK(over.parts() == std::vector<std::vector<int>>{{0, 1, 2, 3, 4}, {3, 4, 5, 6, 7, 8}, {7, 8, 9}});
+    // A remainder below a quarter of the block size joins its neighbour: {9} into {0..8}.
+    o.block = 9, o.overlap = 0;
+    NonlinearElimination merged(P, o);
+    REQUIRE(merged.select(g));
+    CHECK(merged.parts() == std::vector<std::vector<int>>{{0, 1, 2, 3, 4, 5, 6, 7, 8, 9}});
+    CHECK_FALSE(merged.at_trial_points());
+    CHECK(NonlinearElimination(P, EliminationOptions{}).at_trial_points());
+}
+
+TEST_CASE("Newton with the Schwarz sweep returns plain Newton's equilibrium of the whole network, energy never rising",
+          "[solve][elimination]") {
+    Sheared net;
+    StrainedEnergy f(*net.e, net.F);
+    Eigen::VectorXd q0 = affine_start(*net.e, net.F), q_plain = q0;
+    const SolveResult plain = solve(f, q_plain, false);
+    REQUIRE(plain.converged());
+    for (int kind : {0, 1}) {
+        CAPTURE(kind);
+        Recording rec(f, kind);
+        Eigen::VectorXd q = q0;
+        SolverOptions o;
+        o.tol = 1e-9, o.eliminate = true, o.elimination.block = 200;
+        NewtonSolver s(o);
+        const SolveResult r = s.minimize(rec, q);
+        REQUIRE(r.converged());
+        // A sweep before every global step, and one more if the last sweep left the whole gradient within tol.
+        CHECK(r.eliminating_iterations >= r.iterations);
+        CHECK(r.eliminating_iterations <= r.iterations + 1);
+        CHECK(r.local_solves >= 2 * r.eliminating_iterations);
+        Eigen::VectorXd g;
+        const double E = f.gradient(q, g);
+        CHECK(g.lpNorm<Eigen::Infinity>() <= 1e-9);
+        for (size_t k = 1; k < rec.energies.size(); ++k) {  // as with the hot places' elimination (above)
+            const int steps = 1 + rec.restrictions_at[k] - rec.restrictions_at[k - 1];
+            INFO("assembly " << k << ": " << steps << " solves since the last");
+            CHECK(rec.energies[k] - rec.energies[k - 1] <= 1e-12 * steps * (1 + std::abs(rec.energies[k - 1])));
+        }
+        CHECK(std::abs(E - plain.energy) <= 1e-12 * std::abs(plain.energy) + 1e-15);
+    }
 }
 
 TEST_CASE("elimination selects connected parts of the hot coordinates grown through the pattern", "[solve][elimination]") {

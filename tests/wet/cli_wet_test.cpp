@@ -287,7 +287,8 @@ TEST_CASE("cli wet: summary.json records what reproduces the run", "[wet][cli]")
     CHECK(w["law_fnv1a"].is_number_unsigned());
     CHECK(w["moduli"] == false);
     CHECK(j["solver"] == nlohmann::json({{"name", "newton"}, {"tol", 1e-10}, {"max_iter", 500}, {"eliminate", true},
-                                         {"eliminate_hops", nullptr}}));  // the event model keeps the solver's hops
+                                         {"eliminate_hops", nullptr},  // the event model keeps the solver's hops
+                                         {"schwarz_block", nullptr}, {"schwarz_overlap", nullptr}}));
     CHECK(j["prune"] == nlohmann::json::array());
     CHECK(j["parameters"]["seed"] == 3);
     // The default law is named, with no table.
@@ -410,6 +411,26 @@ TEST_CASE("cli wet: the smooth model with nonlinear elimination reaches an equil
     CHECK(r["energy"]["wet"]["capillary"].get<double>() < 0);
 }
 
+TEST_CASE("cli wet: the smooth model with the Schwarz sweep reaches an equilibrium of the whole energy",
+          "[wet][cli][smooth]") {
+    // Blocks of 100 coordinates on a network of about 1000: every global iteration relaxes several blocks first.
+    const std::string out = tmpdir() + "/smooth_schwarz";
+    REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);
+    REQUIRE(run("--L 2.5 --q 8 --pl 0.5 --seed 3 --beta 0.1 --wet-model smooth --bundle-partners 2 --wet-schwarz 100 "
+                "--no-moduli --tol 1e-9 -q -o " + out) == 0);
+    const nlohmann::json j = read_json(out + "/summary.json");
+    CHECK(j["solver"]["eliminate"] == true);
+    CHECK(j["solver"]["schwarz_block"] == 100);
+    CHECK(j["solver"]["schwarz_overlap"] == 4);
+    const nlohmann::json& r = j["runs"][0];
+    CHECK(r["status"] == "stable");
+    CHECK(r["smooth"]["grad_max"].get<double>() <= 1e-9);
+    // A sweep before every global step, each over several blocks.
+    CHECK(r["smooth"]["eliminating_iterations"].get<int>() >= r["solver"]["iterations"].get<int>());
+    CHECK(r["smooth"]["local_solves"].get<int>() >= 2 * r["smooth"]["eliminating_iterations"].get<int>());
+    CHECK(r["energy"]["wet"]["capillary"].get<double>() < 0);
+}
+
 TEST_CASE("cli wet: the smooth model with projected Newton and a partner cap", "[wet][cli][smooth]") {
     // A cap of 1 binds at beta = 0.1 on this network (the capillary energy is above the uncapped one), and the exact
     // linear modulus, whose strain derivatives carry the cap's coupling, matches the second difference.
@@ -451,5 +472,14 @@ TEST_CASE("cli wet: the smooth model's options are refused by name", "[wet][cli]
     CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --wet-eliminate --wet-eliminate-hops -1 "
               "-q -o " + out) == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("[wet].eliminate_hops = -1") != std::string::npos);
+    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --wet-schwarz -5 -q -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("[wet].schwarz_block = -5") != std::string::npos);
+    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --wet-schwarz 100 --wet-schwarz-overlap -1 "
+              "-q -o " + out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("[wet].schwarz_overlap = -1") != std::string::npos);
+    CHECK(run("--L 2.5 --q 8 --pl 1 --seed 3 --beta 0.01 --wet-model smooth --wet-schwarz 100 --solver lbfgs -q -o " +
+              out) == 2);
+    CHECK(slurp(tmpdir() + "/stderr").find("[wet].schwarz_block = 100 needs a solver with nonlinear elimination") !=
+          std::string::npos);
     CHECK(!exists(out));
 }

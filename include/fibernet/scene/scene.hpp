@@ -44,6 +44,11 @@ struct WetSettings {
     // The smooth model's elimination: hops the hot set grows by (EliminationOptions::hops; the dry default of 16 grows
     // a wet hot set past the quarter of the coordinates where elimination stands aside).
     int eliminate_hops = 2;
+    // Newton's Schwarz sweep in the wet relaxation (EliminationOptions::block, overlap): before each global step every
+    // coordinate is relaxed, in connected blocks of about schwarz_block coordinates grown by schwarz_overlap hops
+    // (0: off; > 0 implies newton_eliminate in that form; docs/wet.md, "The Schwarz sweep").
+    int schwarz_block = 0;
+    int schwarz_overlap = 4;
     // Local rounds (docs/wet.md, "Local rounds"): the part of the network that needs a solve, if it holds at most
     // local_fraction of the coordinates (0: every round global); hot: |g| > local_threshold x max|g|, grown by local_hops.
     double local_fraction = 0.25;

@@ -10,6 +10,12 @@
 //   - inside the global line search, the same parts are minimized again at every trial point, so the global step is
 //     judged with the places back in their valleys (the Newton step on the remaining coordinates is then the step on
 //     the reduced energy, whose Hessian is the Schur complement, because the parts' gradients vanish).
+// The Schwarz sweep (EliminationOptions::block > 0; a multiplicative Schwarz smoother, Dolean, Jolivet & Nataf 2015,
+// ch. 1, used as the nonlinear preconditioner of a global Newton step, Cai & Keyes 2002) solves every place instead of the
+// hot ones: the coordinates are split into connected blocks of about `block` coordinates, each grown by `overlap` hops,
+// and before each global step every block is minimized in turn with the rest held. Regions far apart then relax in the
+// same global iteration, where a global line search serves one region at a time; the global step is left to the
+// coupling between blocks, so it is taken without local solves at its trial points.
 // Every local solve only lowers the energy, so the global energy never rises; convergence is still tested on the
 // whole gradient. The solver sees only value, gradient, Hessian and the pattern; an objective that offers
 // Objective::restriction is restricted at the cost of the parts' elements, any other through SubsetObjective.
@@ -28,6 +34,9 @@ struct EliminationOptions {
     double max_fraction = 0.25; // no elimination when the grown set holds more than this share of the coordinates
     double local_rtol = 1e-3;   // a part is solved to max|g_part| <= max(tol, local_rtol max|g|), in (0, 1)
     int local_max_iter = 200;   // Newton iterations per part and solve, >= 1
+    int block = 0;              // > 0: the Schwarz sweep over blocks of about this many coordinates (threshold, hops
+                                // and max_fraction then unused); 0: the hot places only
+    int overlap = 4;            // the Schwarz blocks' overlap: hops each block is grown by, >= 0
 
     // Throws InputError("<where>: elimination.<name> = <v> must ...").
     void check(const std::string& where) const;
@@ -53,8 +62,10 @@ public:
     void set_pattern(const Eigen::SparseMatrix<double>& pattern);
 
     // Picks the parts from the gradient g at the current state; false (no parts) when nothing is hot beyond the grown
-    // set's size limit or max|g| is zero.
+    // set's size limit or max|g| is zero. The Schwarz sweep's parts are its blocks, whatever g.
     bool select(const Eigen::VectorXd& g);
+    // The local solves judge a global step's trial points too (the hot places' elimination; not the Schwarz sweep's).
+    bool at_trial_points() const { return opt_.block == 0; }
     const std::vector<std::vector<int>>& parts() const { return parts_; }
     int coordinates() const { return selected_; }
 
@@ -66,11 +77,13 @@ public:
     const EliminationCounts& counts() const { return counts_; }
 
 private:
+    void partition();  // the Schwarz blocks of the current coupling graph
+
     EliminationOptions opt_;
     bool median_floor_;
     double max_step_;
     std::vector<int> adj_start_, adj_;  // symmetric coupling graph over the coordinates
-    std::vector<std::vector<int>> parts_;
+    std::vector<std::vector<int>> parts_, blocks_;
     int selected_ = 0;
     EliminationCounts counts_;
 };
