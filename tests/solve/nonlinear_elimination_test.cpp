@@ -70,6 +70,30 @@ private:
     int kind_;
 };
 
+// The Hessian pattern of a chain of n coordinates (tridiagonal, upper triangle).
+Eigen::SparseMatrix<double> chain_pattern(int n) {
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < n; ++i) {
+        t.emplace_back(i, i, 0.0);
+        if (i + 1 < n) t.emplace_back(i, i + 1, 0.0);
+    }
+    Eigen::SparseMatrix<double> P(n, n);
+    P.setFromTriplets(t.begin(), t.end());
+    return P;
+}
+
+// Energy at every full assembly: non-increasing (local solves and accepted steps only lower it), up to what Newton
+// accepts in the round-off regime, a rise of at most 1e-12 (1 + |E|) per accepted step (newton.hpp), the global
+// step's and each local solve's between the two assemblies (a part's energy is at most E: every term is >= 0). Rises
+// of 1e-15 relative occur with some CPUs' kernels.
+void check_never_rising(const Recording& rec) {
+    for (size_t k = 1; k < rec.energies.size(); ++k) {
+        const int steps = 1 + rec.restrictions_at[k] - rec.restrictions_at[k - 1];
+        INFO("assembly " << k << ": " << steps << " solves since the last");
+        CHECK(rec.energies[k] - rec.energies[k - 1] <= 1e-12 * steps * (1 + std::abs(rec.energies[k - 1])));
+    }
+}
+
 SolveResult solve(Objective& f, Eigen::VectorXd& q, bool eliminate) {
     SolverOptions o;
     o.tol = 1e-9, o.eliminate = eliminate;
@@ -77,15 +101,27 @@ SolveResult solve(Objective& f, Eigen::VectorXd& q, bool eliminate) {
     return s.minimize(f, q);
 }
 
+// The sheared network, its affine start and plain Newton's solve from there.
+struct PlainReference {
+    Sheared net;
+    StrainedEnergy f{*net.e, net.F};
+    Eigen::VectorXd q0 = affine_start(*net.e, net.F);
+    SolveResult plain;
+    PlainReference() {
+        Eigen::VectorXd q = q0;
+        plain = solve(f, q, false);
+    }
+};
+
 }  // namespace
 
 TEST_CASE("Newton with elimination returns plain Newton's equilibrium of the whole network, energy never rising",
           "[solve][elimination]") {
-    Sheared net;
-    StrainedEnergy f(*net.e, net.F);
-    Eigen::VectorXd q0 = affine_start(*net.e, net.F), q_plain = q0;
-    const SolveResult plain = solve(f, q_plain, false);
-    REQUIRE(plain.converged());
+    PlainReference ref;
+    REQUIRE(ref.plain.converged());
+    StrainedEnergy& f = ref.f;
+    const Eigen::VectorXd& q0 = ref.q0;
+    const SolveResult& plain = ref.plain;
     for (int kind : {0, 1, 2}) {
         CAPTURE(kind);
         Recording rec(f, kind);
@@ -100,16 +136,7 @@ TEST_CASE("Newton with elimination returns plain Newton's equilibrium of the who
         Eigen::VectorXd g;
         const double E = f.gradient(q, g);
         CHECK(g.lpNorm<Eigen::Infinity>() <= 1e-9);
-        // Energy at every full assembly: non-increasing (local solves and accepted steps only lower it), up to what
-        // Newton accepts in the round-off regime, a rise of at most 1e-12 (1 + |E|) per accepted step (newton.hpp),
-        // the global step's and each local solve's between the two assemblies (a part's energy is at most E: every
-        // term is >= 0). Rises of 1e-15 relative occur with some CPUs' kernels.
-        if (kind < 2)
-            for (size_t k = 1; k < rec.energies.size(); ++k) {
-                const int steps = 1 + rec.restrictions_at[k] - rec.restrictions_at[k - 1];
-                INFO("assembly " << k << ": " << steps << " solves since the last");
-                CHECK(rec.energies[k] - rec.energies[k - 1] <= 1e-12 * steps * (1 + std::abs(rec.energies[k - 1])));
-            }
+        if (kind < 2) check_never_rising(rec);
         // The same minimum: with max|g| <= 1e-9 on both, the energies differ by O(|g|^2 / stiffness), far below 1e-12.
         CHECK(std::abs(E - plain.energy) <= 1e-12 * std::abs(plain.energy) + 1e-15);
         CHECK(r.factorizations < plain.factorizations);  // the point of it, on this network 30 against 58
@@ -159,15 +186,8 @@ TEST_CASE("elimination options out of range are refused by name", "[solve][elimi
 }
 
 TEST_CASE("the Schwarz sweep's blocks cover every coordinate, connected, grown by the overlap", "[solve][elimination]") {
-    // A chain of 10 coordinates (tridiagonal pattern).
     const int n = 10;
-    std::vector<Eigen::Triplet<double>> t;
-    for (int i = 0; i < n; ++i) {
-        t.emplace_back(i, i, 0.0);
-        if (i + 1 < n) t.emplace_back(i, i + 1, 0.0);
-    }
-    Eigen::SparseMatrix<double> P(n, n);
-    P.setFromTriplets(t.begin(), t.end());
+    const Eigen::SparseMatrix<double> P = chain_pattern(n);
     EliminationOptions o;
     o.block = 4, o.overlap = 0;
     NonlinearElimination ne(P, o);
@@ -192,15 +212,12 @@ TEST_CASE("the Schwarz sweep's blocks cover every coordinate, connected, grown b
 
 TEST_CASE("Newton with the Schwarz sweep returns plain Newton's equilibrium of the whole network, energy never rising",
           "[solve][elimination]") {
-    Sheared net;
-    StrainedEnergy f(*net.e, net.F);
-    Eigen::VectorXd q0 = affine_start(*net.e, net.F), q_plain = q0;
-    const SolveResult plain = solve(f, q_plain, false);
-    REQUIRE(plain.converged());
+    PlainReference ref;
+    REQUIRE(ref.plain.converged());
     for (int kind : {0, 1}) {
         CAPTURE(kind);
-        Recording rec(f, kind);
-        Eigen::VectorXd q = q0;
+        Recording rec(ref.f, kind);
+        Eigen::VectorXd q = ref.q0;
         SolverOptions o;
         o.tol = 1e-9, o.eliminate = true, o.elimination.block = 200;
         NewtonSolver s(o);
@@ -211,27 +228,17 @@ TEST_CASE("Newton with the Schwarz sweep returns plain Newton's equilibrium of t
         CHECK(r.eliminating_iterations <= r.iterations + 1);
         CHECK(r.local_solves >= 2 * r.eliminating_iterations);
         Eigen::VectorXd g;
-        const double E = f.gradient(q, g);
+        const double E = ref.f.gradient(q, g);
         CHECK(g.lpNorm<Eigen::Infinity>() <= 1e-9);
-        for (size_t k = 1; k < rec.energies.size(); ++k) {  // as with the hot places' elimination (above)
-            const int steps = 1 + rec.restrictions_at[k] - rec.restrictions_at[k - 1];
-            INFO("assembly " << k << ": " << steps << " solves since the last");
-            CHECK(rec.energies[k] - rec.energies[k - 1] <= 1e-12 * steps * (1 + std::abs(rec.energies[k - 1])));
-        }
-        CHECK(std::abs(E - plain.energy) <= 1e-12 * std::abs(plain.energy) + 1e-15);
+        check_never_rising(rec);
+        CHECK(std::abs(E - ref.plain.energy) <= 1e-12 * std::abs(ref.plain.energy) + 1e-15);
     }
 }
 
 TEST_CASE("elimination selects connected parts of the hot coordinates grown through the pattern", "[solve][elimination]") {
     // A chain of 10 coordinates (tridiagonal pattern), hot at 1 and 8: one hop grows {0,1,2} and {7,8,9}, two parts.
     const int n = 10;
-    std::vector<Eigen::Triplet<double>> t;
-    for (int i = 0; i < n; ++i) {
-        t.emplace_back(i, i, 0.0);
-        if (i + 1 < n) t.emplace_back(i, i + 1, 0.0);
-    }
-    Eigen::SparseMatrix<double> P(n, n);
-    P.setFromTriplets(t.begin(), t.end());
+    const Eigen::SparseMatrix<double> P = chain_pattern(n);
     EliminationOptions o;
     o.threshold = 0.5, o.hops = 1, o.max_fraction = 1;
     NonlinearElimination ne(P, o);
