@@ -623,6 +623,8 @@ private:
 
     nlohmann::json summary(bool complete) const {
         const Scene& s = in_.s;
+        const SolverOptions& elimination = in_.opt.solver_options;  // as run_options set it from the scene
+        const int sweep = elimination.elimination.block;
         return nlohmann::json{{"scene", s.source},
                               {"command", command_},
                               {"parameters", parameters_},
@@ -633,12 +635,10 @@ private:
                               {"strain", to_string(s.strain)},
                               {"gamma", s.gamma},
                               {"solver", {{"name", s.solver.name}, {"tol", s.solver.tol}, {"max_iter", s.solver.max_iter},
-                                          {"eliminate", s.wet.newton_eliminate || s.wet.schwarz_block > 0},
-                                          {"schwarz_block", s.wet.schwarz_block > 0 ? nlohmann::json(s.wet.schwarz_block)
-                                                                                    : nlohmann::json()},
-                                          {"schwarz_overlap", s.wet.schwarz_block > 0
-                                                                  ? nlohmann::json(s.wet.schwarz_overlap)
-                                                                  : nlohmann::json()},
+                                          {"eliminate", elimination.eliminate},
+                                          {"schwarz_block", sweep ? nlohmann::json(sweep) : nlohmann::json()},
+                                          {"schwarz_overlap", sweep ? nlohmann::json(elimination.elimination.overlap)
+                                                                    : nlohmann::json()},
                                           {"eliminate_hops", s.wet.newton_eliminate && s.wet.model == "smooth"
                                                                  ? nlohmann::json(s.wet.eliminate_hops)
                                                                  : nlohmann::json()}}},

@@ -102,8 +102,7 @@ bool NonlinearElimination::select(const Eigen::VectorXd& g) {
     const int n = static_cast<int>(g.size());
     const double gmax = n > 0 ? g.lpNorm<Eigen::Infinity>() : 0.0;
     if (!(gmax > 0)) return false;
-    if (opt_.block > 0) {
-        parts_ = blocks_;
+    if (opt_.block > 0) {  // parts() are the blocks
         selected_ = n;
         ++counts_.selections;
         return true;
@@ -147,7 +146,7 @@ void NonlinearElimination::eliminate(Objective& f, Eigen::VectorXd& q, double to
     const auto t0 = std::chrono::steady_clock::now();
     SolverOptions o;
     o.tol = tol, o.max_iter = opt_.local_max_iter, o.median_floor = median_floor_, o.max_step = max_step_;
-    for (const std::vector<int>& part : parts_) {
+    for (const std::vector<int>& part : parts()) {
         if (max_seconds > 0) {
             const double left = max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             if (left <= 0) break;

@@ -66,7 +66,7 @@ public:
     bool select(const Eigen::VectorXd& g);
     // The local solves judge a global step's trial points too (the hot places' elimination; not the Schwarz sweep's).
     bool at_trial_points() const { return opt_.block == 0; }
-    const std::vector<std::vector<int>>& parts() const { return parts_; }
+    const std::vector<std::vector<int>>& parts() const { return opt_.block > 0 ? blocks_ : parts_; }
     int coordinates() const { return selected_; }
 
     // Minimizes f over each part in turn, the others held, overwriting q's entries of the parts; never raises f.
