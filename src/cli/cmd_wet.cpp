@@ -569,8 +569,12 @@ public:
                            release();
                        }) {
         if (start_) in_.opt.wet_start = start_->q;
-        if (checkpoints_.enabled())
+        if (checkpoints_.enabled()) {
             in_.opt.observe_wet = [this](const Eigen::VectorXd& q, double e, double g) { checkpoints_.observe(q, e, g); };
+            in_.opt.observe_wet_within = [this](const Eigen::VectorXd& q, const std::function<double()>& e) {
+                checkpoints_.observe_within(q, e);
+            };
+        }
         sweep_ << "beta,status,bridges,moves,ruptures,formed,merged,rounds,E_stretch,E_bend,E_capillary,pores,"
                   "mean_pore_area,mean_pore_diameter,bundled_fibers,largest_bundle,G_dry,G_wet,G_dry_fd,G_wet_fd";
         if (in_.opt.free_box.enabled)

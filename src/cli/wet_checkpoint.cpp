@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "common.hpp"
@@ -120,6 +121,11 @@ void WetCheckpoints::observe(const Eigen::VectorXd& q, double energy, double gra
     write(q, energy, grad_max, false);
 }
 
+void WetCheckpoints::observe_within(const Eigen::VectorXd& q, const std::function<double()>& energy) {
+    if (!enabled() || since(last_) < every_) return;
+    write(q, energy(), std::numeric_limits<double>::quiet_NaN(), false);
+}
+
 std::string WetCheckpoints::keep_last(const Eigen::VectorXd& q, double energy, double grad_max) {
     if (!enabled()) return "";
     write(q, energy, grad_max, true);
@@ -158,6 +164,7 @@ bool WetCheckpoints::kept(const std::string& file) const {
 
 void WetCheckpoints::write(const Eigen::VectorXd& q, double energy, double grad_max, bool last) {
     const std::string stem = "checkpoint_" + std::to_string(k_);
+    const bool within = std::isnan(grad_max);
     const double seconds = since(t0_);
     const long before_it = start_ ? start_->iterations_before : 0;
     const double before_s = start_ ? start_->seconds_before : 0;
@@ -177,7 +184,8 @@ void WetCheckpoints::write(const Eigen::VectorXd& q, double energy, double grad_
         {"last", last},  // true: the relaxation ended here unconverged; false: it was still running
         {"converged", false},
         {"energy", energy},
-        {"grad_max", grad_max},
+        {"grad_max", within ? nlohmann::json() : nlohmann::json(grad_max)},
+        {"within_iteration", within},  // true: between the local solves after iterate `iterations` (its gradient unknown)
         {"iterations", iterations_},
         {"seconds", seconds},
         {"iterations_total", before_it + iterations_},  // with the runs this one continued (--start-state)
@@ -193,7 +201,10 @@ void WetCheckpoints::write(const Eigen::VectorXd& q, double energy, double grad_
     });
     last_ = std::chrono::steady_clock::now();
     written_ = true;
-    if (progress_ && !last)
+    if (progress_ && !last && within)
+        std::fprintf(stderr, "wet: checkpoint after iteration %ld, within the next one's local solves (E = %.10g): %s%s.txt\n",
+                     iterations_, energy, dir_.c_str(), stem.c_str());
+    else if (progress_ && !last)
         std::fprintf(stderr, "wet: checkpoint at iteration %ld (E = %.10g, max|g| = %.3g): %s%s.txt\n", iterations_,
                      energy, grad_max, dir_.c_str(), stem.c_str());
 }

@@ -48,6 +48,9 @@ public:
     // An accepted iterate (SolverOptions::observe): written once `every` seconds have passed since the last write (or
     // the start).
     void observe(const Eigen::VectorXd& q, double energy, double grad_max);
+    // A state between the local solves of an iteration (SolverOptions::observe_within): written on the same clock, with
+    // its energy evaluated then and its max|g| unknown (null in the JSON; "within_iteration": true).
+    void observe_within(const Eigen::VectorXd& q, const std::function<double()>& energy);
     // The relaxation of beta k ended unconverged: its last state is written as the checkpoint; returns the state file's
     // name in the directory ("" without checkpoints).
     std::string keep_last(const Eigen::VectorXd& q, double energy, double grad_max);
@@ -58,6 +61,7 @@ public:
     void remove_stale() const;
 
 private:
+    // grad_max NaN: a state within an iteration, whose gradient was not evaluated.
     void write(const Eigen::VectorXd& q, double energy, double grad_max, bool last);
     bool kept(const std::string& file) const;  // the start state or its JSON
 

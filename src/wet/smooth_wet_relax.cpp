@@ -33,6 +33,7 @@ void configure(SolverOptions& o, const SolverOptions& base, const SolverCapabili
     o.projected = base.projected || (opt.projected && caps.projected && wet);
     o.ldl = !o.projected && (base.ldl || (opt.ldl && caps.ldl && wet));
     if (opt.observe) o.observe = opt.observe;
+    if (opt.observe_within) o.observe_within = opt.observe_within;
 }
 
 void add(SmoothRelaxResult& R, const SolveResult& s) {

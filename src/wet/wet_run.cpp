@@ -117,6 +117,7 @@ void run_wet_smooth(WetRun& run, const Network& net, const NetworkEnergy& dry, c
     run.initial_bridges = W.bridges(run.wet.q);
     SmoothRelaxOptions ro = opt.smooth_relax;
     ro.observe = opt.observe_wet;
+    ro.observe_within = opt.observe_wet_within;
     run.smooth = relax_smooth_wet(W, solver, run.wet.q, ro);
     run.seconds_wet_solve = run.smooth.seconds;
     run.active.seconds_solve = run.smooth.seconds;

@@ -82,6 +82,33 @@ TEST_CASE("wet checkpoint: an unconverged relaxation leaves its last state, and 
     CHECK(exists(a + "/checkpoint_0.txt"));   // the start state is the user's file: kept
 }
 
+TEST_CASE("wet checkpoint: the Schwarz sweep is checkpointed between its local solves", "[cli][wet][checkpoint]") {
+    const std::string a = tmpdir() + "/ck_sweep";
+    REQUIRE(std::system(("rm -rf " + a).c_str()) == 0);
+    // One global iteration (the sweep over blocks of 100 coordinates and one global step), checkpoints at every chance.
+    const std::string scene = tmpdir() + "/one.toml";
+    clitest::write(scene, "[wet]\nmax_rounds = 1\nround_iterations = 1\ncheckpoint_seconds = 1e-9\n");
+    REQUIRE(run("wet " + scene + " " + kNetwork + " -v --betas 0.1 --wet-schwarz 100 -o " + a) == 1);
+    const std::string trace = slurp(tmpdir() + "/stderr");
+    const std::string line = "wet: checkpoint after iteration 0, within the next one's local solves (E = ";
+    const size_t iterate = trace.find("newton    0  E = ", trace.find("newton: "));
+    REQUIRE(iterate != std::string::npos);
+    const size_t within = trace.rfind(line, iterate);  // the last written during the first sweep, before the first iterate
+    REQUIRE(within != std::string::npos);
+    // Its energy lies between the dry start (energy 0 at the unstrained dry equilibrium) and the first iterate's:
+    // every local solve lowers the energy, and so does the global step.
+    const double e_within = std::strtod(trace.c_str() + within + line.size(), nullptr);
+    const double e_first = std::strtod(trace.c_str() + iterate + 17, nullptr);
+    CHECK(e_within < 0);
+    CHECK(e_first <= e_within + 1e-9 * std::abs(e_within));
+    // The last state is a whole iterate's: the JSON says so and carries its max|g|.
+    const nlohmann::json c = read_json(a + "/checkpoint_0.json");
+    REQUIRE(c.is_object());
+    CHECK(c["last"] == true);
+    CHECK(c["within_iteration"] == false);
+    CHECK(c["grad_max"].is_number());
+}
+
 TEST_CASE("wet checkpoint: a running relaxation's checkpoints survive SIGINT", "[cli][wet][checkpoint][signal]") {
     const std::string out = tmpdir() + "/ck_sigint";
     REQUIRE(std::system(("rm -rf " + out).c_str()) == 0);

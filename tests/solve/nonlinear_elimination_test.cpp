@@ -3,7 +3,9 @@
 // through an objective's own restriction and through SubsetObjective alike; options are checked by name.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -286,4 +288,34 @@ TEST_CASE("elimination's local solves share the caller's time budget", "[solve][
     const SolveResult r = NewtonSolver(o).minimize(f, q3);
     CHECK(r.status == SolveStatus::IterationLimit);
     CHECK(r.message == "time limit reached");
+}
+
+TEST_CASE("Newton's observe_within sees the state after each local solve of a sweep, its energy never rising",
+          "[solve][elimination]") {
+    PlainReference ref;
+    Eigen::VectorXd q = ref.q0;
+    SolverOptions o;
+    o.tol = 1e-9, o.eliminate = true, o.elimination.block = 200;
+    // Energies in the order the hooks see them: iterates (observe) and states between local solves (observe_within).
+    std::vector<double> seen;
+    std::vector<char> within;
+    o.observe = [&](const Eigen::VectorXd&, double E, double) { seen.push_back(E), within.push_back(0); };
+    o.observe_within = [&](const Eigen::VectorXd& qw, const std::function<double()>& energy) {
+        const double E = energy();
+        CHECK(E == ref.f.value(qw));  // energy() evaluates the whole objective at the state handed over
+        seen.push_back(E), within.push_back(1);
+    };
+    const SolveResult r = NewtonSolver(o).minimize(ref.f, q);
+    REQUIRE(r.converged());
+    // Every local solve of the sweep is followed by a call (none at a line search's trial points: the sweep has none).
+    CHECK(std::count(within.begin(), within.end(), 1) == r.local_solves);
+    CHECK(std::count(within.begin(), within.end(), 0) == r.iterations);
+    REQUIRE(within.size() >= 2);
+    CHECK(within.front() == 1);  // the first sweep comes before the first iterate
+    const double E0 = ref.f.value(ref.q0);
+    for (size_t k = 0; k < seen.size(); ++k) {
+        const double before = k == 0 ? E0 : seen[k - 1];
+        INFO("state " << k << (within[k] ? " (between local solves)" : " (iterate)"));
+        CHECK(seen[k] - before <= 1e-12 * (1 + std::abs(before)));
+    }
 }

@@ -41,6 +41,11 @@ struct SolverOptions {
     // (Newton, L-BFGS, CG, FIRE; not NLopt or Ipopt, whose loops are their own): a caller's hook for checkpoints of
     // long solves (`fibernet wet --checkpoint-seconds`). Empty: none.
     std::function<void(const Eigen::VectorXd& q, double energy, double grad_max)> observe;
+    // Newton with the Schwarz sweep or elimination: called between the parts of the local solves before a global step
+    // with the state so far (its energy below the last iterate's; not an iterate, so its gradient is not evaluated;
+    // energy() evaluates it, for a hook that writes it). A sweep of a large network takes minutes to hours
+    // (docs/wet.md, "The Schwarz sweep"), and a checkpoint at iterates only would lose it to an interrupt. Empty: none.
+    std::function<void(const Eigen::VectorXd& q, const std::function<double()>& energy)> observe_within;
 
     // The one check of these options (every solver's constructor calls it): throws InputError("<where>: <name> = <v>
     // must ..."), `where` naming the solver.

@@ -31,6 +31,8 @@ struct SmoothRelaxOptions {
     bool follow_pattern = true;  // false: rounds for every solver (tests: the two ways agree)
     // Called with each accepted iterate of the relaxation, over all its rounds (SolverOptions::observe); empty: none.
     std::function<void(const Eigen::VectorXd& q, double energy, double grad_max)> observe;
+    // Called between the local solves of a global iteration (SolverOptions::observe_within); empty: none.
+    std::function<void(const Eigen::VectorXd& q, const std::function<double()>& energy)> observe_within;
 };
 
 struct SmoothRelaxResult {
