@@ -1,5 +1,7 @@
 #include "fibernet/util/parallel.hpp"
 
+#include <omp.h>
+
 #include <atomic>
 #include <cstdlib>
 #include <stdexcept>
@@ -11,11 +13,22 @@ namespace fibernet {
 
 namespace {
 std::atomic<int> override_count{0};
+
+// fibernet has no OpenMP loop of its own; CHOLMOD's supernodal factorization has, and asks for a number of threads
+// fixed when it was built (CHOLMOD_OMP_NUM_THREADS, 4 in Debian's), whatever OMP_NUM_THREADS says. On one thread,
+// OpenMP's teams are turned off instead (max-active-levels 0: a parallel region runs on the thread that meets it), so
+// that a single-threaded run or a scan's rank does not wake 3 more threads per supernode (docs/benchmarks.md,
+// "CHOLMOD's OpenMP threads"). More threads: OpenMP's own setting, as the process started with it.
+void openmp_for(int threads) {
+    static const int initial = omp_get_max_active_levels();
+    omp_set_max_active_levels(threads == 1 ? 0 : initial);
 }
+}  // namespace
 
 void set_thread_count(int n) {
     if (n < 0) throw std::invalid_argument("set_thread_count: n = " + std::to_string(n) + " must be >= 0");
     override_count = n;
+    openmp_for(n > 0 ? n : thread_count_default());
 }
 
 int thread_count() {
@@ -35,6 +48,11 @@ int thread_count_default() {
         const unsigned h = std::thread::hardware_concurrency();
         return h == 0 ? 1 : static_cast<int>(h);
     }();
+    static const bool applied = [] {
+        if (!override_count.load()) openmp_for(n);
+        return true;
+    }();
+    (void)applied;
     return n;
 }
 

@@ -1,10 +1,15 @@
-// parallel_ranges and parallel_blocks (util/parallel.hpp): every index once; errors reach the caller.
+// parallel_ranges and parallel_blocks (util/parallel.hpp): every index once; errors reach the caller. One thread keeps
+// CHOLMOD's OpenMP regions on the calling thread.
 #include <catch2/catch.hpp>
 
 #include <atomic>
+#include <filesystem>
 #include <stdexcept>
 #include <vector>
 
+#include <Eigen/SparseCore>
+
+#include "fibernet/solve/cholmod_llt.hpp"
 #include "fibernet/util/parallel.hpp"
 
 using namespace fibernet;
@@ -63,4 +68,36 @@ TEST_CASE("parallel_blocks: an exception in the first task or a block is rethrow
                                         if (lo == 50) throw std::runtime_error("a block");
                                     }),
                     std::runtime_error);
+}
+
+namespace {
+int threads_of_this_process() {
+    int n = 0;
+    for ([[maybe_unused]] const auto& t : std::filesystem::directory_iterator("/proc/self/task")) ++n;
+    return n;
+}
+}  // namespace
+
+TEST_CASE("one thread: CHOLMOD's supernodal factorization starts no OpenMP thread", "[util][parallel]") {
+    // CHOLMOD asks OpenMP for a fixed 4 threads in its supernodal loops (whatever OMP_NUM_THREADS says); OpenMP keeps
+    // a team's threads alive after its first region, so a region with more than one thread shows in /proc/self/task.
+    set_thread_count(1);
+    const int before = threads_of_this_process();
+    // The 5-point Laplacian of a 150 x 150 grid, shifted: positive definite, with supernodes of hundreds of rows.
+    const int m = 150, n = m * m;
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) {
+            const int k = i * m + j;
+            t.emplace_back(k, k, 4.1);
+            if (j + 1 < m) t.emplace_back(k, k + 1, -1.0);
+            if (i + 1 < m) t.emplace_back(k, k + m, -1.0);
+        }
+    Eigen::SparseMatrix<double> H(n, n);
+    H.setFromTriplets(t.begin(), t.end());
+    CholmodLLT llt;
+    llt.analyze(H);
+    REQUIRE(llt.factorize(H));
+    CHECK(threads_of_this_process() == before);
+    set_thread_count(0);
 }

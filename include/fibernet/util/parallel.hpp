@@ -10,6 +10,8 @@
 namespace fibernet {
 
 // Threads for element loops: the environment variable FIBERNET_THREADS if set (>= 1), else the hardware's count.
+// A count of 1 (from either) also keeps the OpenMP regions of the libraries (CHOLMOD's supernodal factorization) on
+// the calling thread (parallel.cpp).
 int thread_count();
 // Overrides that count from here on (n >= 1; n = 0 removes the override; tests compare thread counts);
 // thread_count_default() is the count without an override.
