@@ -200,7 +200,11 @@ private:
         eliminating_ = false;
         if (!ne_ || !ne_->select(g_)) return Step::again();
         local_tol_ = std::max(opt_.tol, opt_.elimination.local_rtol * gmax_);
-        ne_->eliminate(run.objective(), q, local_tol_, time_left(run), opt_.observe_within);
+        const auto ts = Clock::now();
+        ne_->eliminate(run.objective(), q, local_tol_, time_left(run), [&](const Eigen::VectorXd& qs, int done, int total) {
+            if (opt_.observe_within) opt_.observe_within(qs, [&] { return run.objective().value(qs); });
+            run.tick_within(it, done, total, since(ts));
+        });
         eliminating_ = ne_->at_trial_points();
         const auto ta = Clock::now();
         fq_ = run.objective().hessian(q, g_, H_, projected_);

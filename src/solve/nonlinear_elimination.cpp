@@ -144,8 +144,9 @@ bool NonlinearElimination::select(const Eigen::VectorXd& g) {
 
 void NonlinearElimination::eliminate(
     Objective& f, Eigen::VectorXd& q, double tol, double max_seconds,
-    const std::function<void(const Eigen::VectorXd&, const std::function<double()>&)>& between) {
+    const std::function<void(const Eigen::VectorXd& q, int done, int total)>& between) {
     const auto t0 = std::chrono::steady_clock::now();
+    const int solves_before = counts_.local_solves;
     SolverOptions o;
     o.tol = tol, o.max_iter = opt_.local_max_iter, o.median_floor = median_floor_, o.max_step = max_step_;
     for (const std::vector<int>& part : parts()) {
@@ -165,7 +166,7 @@ void NonlinearElimination::eliminate(
         // Newton accepts only steps that lower the energy, so its last state is never worse than the start, converged
         // or not; a non-finite start leaves qa as it was.
         for (size_t k = 0; k < part.size(); ++k) q[part[k]] = qa[k];
-        if (between) between(q, [&] { return f.value(q); });
+        if (between) between(q, counts_.local_solves - solves_before, static_cast<int>(parts().size()));
     }
     counts_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

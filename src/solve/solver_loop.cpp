@@ -60,6 +60,15 @@ void SolverRun::tick(int k, double energy, double grad_max, const std::string& e
                  extra.empty() ? "" : "  ", extra.c_str());
 }
 
+void SolverRun::tick_within(int k, int done, int total, double spent) {
+    if (!opt_.verbose && !opt_.progress) return;
+    const double t = seconds();
+    if (t < next_tick_ || done <= 0) return;
+    next_tick_ = t + 1.0;
+    std::fprintf(stderr, "%s: it %d  local solves %d of %d  t %.1fs  (about %.0f s more for them)\n", name_.c_str(), k,
+                 done, total, t, spent / done * (total - done));
+}
+
 SolveResult SolverRun::finish(SolveStatus status, const std::string& message, int iterations, double energy,
                               double grad_max) {
     r_.status = status, r_.message = message, r_.iterations = iterations, r_.evaluations = f_.evaluations;

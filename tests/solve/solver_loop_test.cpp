@@ -1,7 +1,12 @@
 // The solver loop (solver_loop.hpp): the stop tests, the iteration and evaluation counts, the finish, and the fresh
 // evaluation that decides a backend's status, with a scripted method on a quadratic whose state is known exactly.
 #include <catch2/catch.hpp>
+#include <unistd.h>
+
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <limits>
 #include <thread>
 #include <vector>
@@ -119,6 +124,47 @@ TEST_CASE("solver loop: observe sees each accepted iterate, the last one the ret
     }
     CHECK(seen_q.back() == q[0]);
     CHECK(seen_e.back() == r.energy);
+}
+
+namespace {
+// What `body` writes to stderr (fd 2), through a temporary file.
+template <class Body>
+std::string stderr_of(Body body) {
+    std::fflush(stderr);
+    std::FILE* tmp = std::tmpfile();
+    const int saved = dup(2);
+    dup2(fileno(tmp), 2);
+    body();
+    std::fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    std::rewind(tmp);
+    std::string out;
+    for (int c; (c = std::fgetc(tmp)) != EOF;) out += static_cast<char>(c);
+    std::fclose(tmp);
+    return out;
+}
+}  // namespace
+
+TEST_CASE("solver loop: progress within the local solves, at most once a second, with what is left", "[solve][loop]") {
+    Quadratic f(2);
+    SolverOptions o;
+    o.progress = true;
+    const Eigen::VectorXd q = Eigen::VectorXd::Constant(2, 1.0);
+    SolverRun run("newton", o, f, q);
+    // Before the first second: nothing (the line is rate-limited from the solve's start).
+    CHECK(stderr_of([&] { run.tick_within(3, 2, 10, 0.5); }).empty());
+    std::this_thread::sleep_for(std::chrono::milliseconds(1050));
+    // 4 of 10 solved in 2 s: about 3 s more.
+    const std::string line = stderr_of([&] { run.tick_within(3, 4, 10, 2.0); });
+    CHECK(line.rfind("newton: it 3  local solves 4 of 10  t 1.", 0) == 0);
+    CHECK(line.find("(about 3 s more for them)\n") != std::string::npos);
+    CHECK(stderr_of([&] { run.tick_within(3, 5, 10, 2.5); }).empty());  // within the same second
+    // Neither verbose nor progress: silent.
+    SolverOptions quiet;
+    SolverRun silent("newton", quiet, f, q);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1050));
+    CHECK(stderr_of([&] { silent.tick_within(0, 1, 2, 1.0); }).empty());
 }
 
 TEST_CASE("solver loop: the iteration budget and the time budget end a solve, named", "[solve][loop]") {

@@ -72,10 +72,10 @@ public:
 
     // Minimizes f over each part in turn, the others held, overwriting q's entries of the parts; never raises f.
     // max_seconds > 0: the parts' solves share this wall-time budget (the caller's remaining one); parts not reached
-    // in it are left as they are. between: called with q after each part's solve (SolverOptions::observe_within); its
-    // energy() evaluates f there.
+    // in it are left as they are. between: called with q after each part's solve, with the parts solved and their number
+    // (for checkpoints and progress: SolverOptions::observe_within).
     void eliminate(Objective& f, Eigen::VectorXd& q, double tol, double max_seconds = 0,
-                   const std::function<void(const Eigen::VectorXd&, const std::function<double()>&)>& between = {});
+                   const std::function<void(const Eigen::VectorXd& q, int done, int total)>& between = {});
 
     const EliminationCounts& counts() const { return counts_; }
 

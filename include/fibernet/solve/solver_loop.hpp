@@ -61,6 +61,10 @@ public:
     bool stop_test(int k, double grad_max, Step& out) const;
     // "<solver>: it <k>  E <e>  max|g| <g>  t <s>" on stderr at most once a second, with options().verbose.
     void tick(int k, double energy, double grad_max, const std::string& extra = "");
+    // "<solver>: it <k>  local solves <done> of <total>  t <s>  (about <r> s more for them)" on the same clock (at most
+    // once a second, with verbose or progress), for the local solves before a global step (the Schwarz sweep), which
+    // at 1e4 fibers take minutes to hours with no iterate to report; `spent`: seconds spent in them so far.
+    void tick_within(int k, int done, int total, double spent);
     // Fills the result (status, message, iterations, evaluations, energy, max|g|, total time) and prints the last line.
     SolveResult finish(SolveStatus status, const std::string& message, int iterations, double energy,
                        double grad_max);
