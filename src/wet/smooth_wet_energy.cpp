@@ -29,6 +29,15 @@ double box_gap_squared(const Vector8d& X) {
     return gx * gx + gy * gy;
 }
 
+// The list's range, CapillaryPairParams::support_distance(L) with its sines taken once: the list asks it for every
+// segment it enters, at each build and at each local solve's update. max(support_distance(0), c0 + s L) is the same
+// number for L >= 0, since support_distance(0) = max(crossing, c0).
+std::function<double(double)> list_range(const CapillaryPairParams& p) {
+    const double crossing = p.support_distance(0), c0 = p.overlap_width + 1.5 * p.contact;
+    const double s = std::sin(p.angle_hi_deg * M_PI / 360);
+    return [=](double L) { return std::max(crossing, c0 + s * L); };
+}
+
 }  // namespace
 
 SmoothWetEnergy::SmoothWetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, SmoothWetParams params,
@@ -37,7 +46,7 @@ SmoothWetEnergy::SmoothWetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d
       F_(F),
       params_(std::move(params)),
       dry_crossings_(std::move(dry_crossings)),
-      list_(dry.model(), [p = params_.pair](double length) { return p.support_distance(length); }, params_.skin) {
+      list_(dry.model(), list_range(params_.pair), params_.skin) {
     params_.pair.check("wet");
     support_crossing_ = params_.pair.support_distance(0);
     support_contact_ = params_.pair.overlap_width + 1.5 * params_.pair.contact;
