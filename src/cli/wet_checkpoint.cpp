@@ -5,7 +5,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <sstream>
 
 #include "common.hpp"
@@ -123,7 +122,7 @@ void WetCheckpoints::observe(const Eigen::VectorXd& q, double energy, double gra
 
 void WetCheckpoints::observe_within(const Eigen::VectorXd& q, const std::function<double()>& energy) {
     if (!enabled() || since(last_) < every_) return;
-    write(q, energy(), std::numeric_limits<double>::quiet_NaN(), false);
+    write(q, energy(), std::nullopt, false);
 }
 
 std::string WetCheckpoints::keep_last(const Eigen::VectorXd& q, double energy, double grad_max) {
@@ -162,9 +161,9 @@ bool WetCheckpoints::kept(const std::string& file) const {
     return c == start_->canonical || c == canonical(sidecar(start_->path));
 }
 
-void WetCheckpoints::write(const Eigen::VectorXd& q, double energy, double grad_max, bool last) {
+void WetCheckpoints::write(const Eigen::VectorXd& q, double energy, std::optional<double> grad_max, bool last) {
     const std::string stem = "checkpoint_" + std::to_string(k_);
-    const bool within = std::isnan(grad_max);
+    const bool within = !grad_max;
     const double seconds = since(t0_);
     const long before_it = start_ ? start_->iterations_before : 0;
     const double before_s = start_ ? start_->seconds_before : 0;
@@ -184,7 +183,7 @@ void WetCheckpoints::write(const Eigen::VectorXd& q, double energy, double grad_
         {"last", last},  // true: the relaxation ended here unconverged; false: it was still running
         {"converged", false},
         {"energy", energy},
-        {"grad_max", within ? nlohmann::json() : nlohmann::json(grad_max)},
+        {"grad_max", within ? nlohmann::json() : nlohmann::json(*grad_max)},
         {"within_iteration", within},  // true: between the local solves after iterate `iterations` (its gradient unknown)
         {"iterations", iterations_},
         {"seconds", seconds},
@@ -206,7 +205,7 @@ void WetCheckpoints::write(const Eigen::VectorXd& q, double energy, double grad_
                      iterations_, energy, dir_.c_str(), stem.c_str());
     else if (progress_ && !last)
         std::fprintf(stderr, "wet: checkpoint at iteration %ld (E = %.10g, max|g| = %.3g): %s%s.txt\n", iterations_,
-                     energy, grad_max, dir_.c_str(), stem.c_str());
+                     energy, *grad_max, dir_.c_str(), stem.c_str());
 }
 
 }  // namespace fibernet::cli

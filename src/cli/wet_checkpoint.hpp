@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <chrono>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,8 +62,8 @@ public:
     void remove_stale() const;
 
 private:
-    // grad_max NaN: a state within an iteration, whose gradient was not evaluated.
-    void write(const Eigen::VectorXd& q, double energy, double grad_max, bool last);
+    // grad_max empty: a state within an iteration, whose gradient was not evaluated.
+    void write(const Eigen::VectorXd& q, double energy, std::optional<double> grad_max, bool last);
     bool kept(const std::string& file) const;  // the start state or its JSON
 
     std::string dir_;

@@ -175,11 +175,12 @@ void terms(const T* X, double lbar, const CapillaryPairParams& p, const Consts& 
 
 }  // namespace
 
-double CapillaryPairParams::support_distance(double max_length) const {
-    const double crossing = 2 * crossing_width / std::sin(angle_lo_deg * M_PI / 180);
-    const double contact_range = overlap_width + 1.5 * contact + max_length * std::sin(angle_hi_deg * M_PI / 360);
-    return std::max(crossing, contact_range);
-}
+double CapillaryPairParams::support_distance(double max_length) const { return PairSupport(*this)(max_length); }
+
+PairSupport::PairSupport(const CapillaryPairParams& p)
+    : crossing(2 * p.crossing_width / std::sin(p.angle_lo_deg * M_PI / 180)),
+      contact(p.overlap_width + 1.5 * p.contact),
+      slope(std::sin(p.angle_hi_deg * M_PI / 360)) {}
 
 void CapillaryPairParams::check(const char* where) const {
     auto positive = [&](double v, const char* name) {

@@ -29,15 +29,6 @@ double box_gap_squared(const Vector8d& X) {
     return gx * gx + gy * gy;
 }
 
-// The list's range, CapillaryPairParams::support_distance(L) with its sines taken once: the list asks it for every
-// segment it enters, at each build and at each local solve's update. max(support_distance(0), c0 + s L) is the same
-// number for L >= 0, since support_distance(0) = max(crossing, c0).
-std::function<double(double)> list_range(const CapillaryPairParams& p) {
-    const double crossing = p.support_distance(0), c0 = p.overlap_width + 1.5 * p.contact;
-    const double s = std::sin(p.angle_hi_deg * M_PI / 360);
-    return [=](double L) { return std::max(crossing, c0 + s * L); };
-}
-
 }  // namespace
 
 SmoothWetEnergy::SmoothWetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d& F, SmoothWetParams params,
@@ -46,11 +37,9 @@ SmoothWetEnergy::SmoothWetEnergy(const NetworkEnergy& dry, const Eigen::Matrix2d
       F_(F),
       params_(std::move(params)),
       dry_crossings_(std::move(dry_crossings)),
-      list_(dry.model(), list_range(params_.pair), params_.skin) {
+      list_(dry.model(), PairSupport(params_.pair), params_.skin),
+      support_(params_.pair) {
     params_.pair.check("wet");
-    support_crossing_ = params_.pair.support_distance(0);
-    support_contact_ = params_.pair.overlap_width + 1.5 * params_.pair.contact;
-    support_slope_ = std::sin(params_.pair.angle_hi_deg * M_PI / 360);
     if (params_.pattern_distance <= 0)
         params_.pattern_distance = 1.5 * params_.pair.contact + params_.pair.overlap_width + params_.pair.crossing_width;
     const Model& m = dry.model();
@@ -116,7 +105,7 @@ void SmoothWetEnergy::index_list() const {
 }
 
 double SmoothWetEnergy::support_distance(double L) const {
-    return std::max(support_crossing_, support_contact_ + support_slope_ * L);
+    return support_(L);
 }
 
 bool SmoothWetEnergy::beyond_support(const Vector8d& X) const {

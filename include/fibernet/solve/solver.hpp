@@ -15,6 +15,10 @@
 
 namespace fibernet {
 
+// A state between the local solves of an iteration, its energy below the last iterate's: not an iterate, so its
+// gradient is not evaluated; energy() evaluates it, for a hook that writes it (SolverOptions::observe_within).
+using WithinObserver = std::function<void(const Eigen::VectorXd& q, const std::function<double()>& energy)>;
+
 struct SolverOptions {
     double tol = 1e-10;      // stop at max|g| <= tol
     int max_iter = 500;      // iteration budget (solver-specific meaning: Newton steps, L-BFGS iterations, ...)
@@ -42,10 +46,9 @@ struct SolverOptions {
     // long solves (`fibernet wet --checkpoint-seconds`). Empty: none.
     std::function<void(const Eigen::VectorXd& q, double energy, double grad_max)> observe;
     // Newton with the Schwarz sweep or elimination: called between the parts of the local solves before a global step
-    // with the state so far (its energy below the last iterate's; not an iterate, so its gradient is not evaluated;
-    // energy() evaluates it, for a hook that writes it). A sweep of a large network takes minutes to hours
-    // (docs/wet.md, "The Schwarz sweep"), and a checkpoint at iterates only would lose it to an interrupt. Empty: none.
-    std::function<void(const Eigen::VectorXd& q, const std::function<double()>& energy)> observe_within;
+    // (WithinObserver). A sweep of a large network takes minutes to hours (docs/wet.md, "The Schwarz sweep"), and a
+    // checkpoint at iterates only would lose it to an interrupt. Empty: none.
+    WithinObserver observe_within;
 
     // The one check of these options (every solver's constructor calls it): throws InputError("<where>: <name> = <v>
     // must ..."), `where` naming the solver.

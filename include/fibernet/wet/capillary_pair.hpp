@@ -30,6 +30,7 @@
 // A pair whose crossing is dry (a crosslinked fiber pair, or one the wetting rule left dry) has only the contact term.
 // Every term is exactly zero (value and derivatives) when the segments are farther apart than support_distance().
 #include <Eigen/Core>
+#include <algorithm>
 
 #include "fibernet/energy/capillary.hpp"
 
@@ -54,6 +55,14 @@ struct CapillaryPairParams {
     double support_distance(double max_length) const;
     // Throws InputError naming the value (and `where`) for a width, contact or angle out of range.
     void check(const char* where) const;
+};
+
+// CapillaryPairParams::support_distance with its sines taken once: the neighbour list asks it for every segment it
+// enters, at each build and at each local solve's update.
+struct PairSupport {
+    double crossing = 0, contact = 0, slope = 0;  // support(L) = max(crossing, contact + slope L)
+    explicit PairSupport(const CapillaryPairParams& p);
+    double operator()(double max_length) const { return std::max(crossing, contact + slope * max_length); }
 };
 
 // The parts of a pair's energy (for reports): crossing weight b W_A W_B (0..1 for a single crossing), the contact

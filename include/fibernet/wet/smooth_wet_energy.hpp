@@ -161,6 +161,7 @@ private:
     SmoothWetParams params_;
     FiberPairs dry_crossings_;
     mutable NeighbourList list_;   // rebuilt where an evaluation finds it invalid (a cache of the geometry)
+    PairSupport support_;          // support_distance()
     Eigen::SparseMatrix<double> pattern_, dry_H_;
     std::vector<int> dry_slot_;
     mutable std::vector<int> patterned_;  // per listed pair: its index among the patterned pairs, or -1
@@ -168,7 +169,6 @@ private:
     mutable int indexed_build_ = -1;      // the list build that index_list() gave patterned_ and wet_ for
     mutable std::vector<int> patterned_next_;  // index_list()'s buffers, kept to spare a list-sized allocation each
     mutable std::vector<char> wet_next_;
-    double support_crossing_ = 0, support_contact_ = 0, support_slope_ = 0;  // support_distance(L) = max(c, c0 + s L)
     std::unordered_map<std::uint64_t, int> pattern_index_;  // patterned pair (key()) -> its index
     int pattern_list_ = 0, pattern_builds_ = 0;
     std::vector<int> slots_;       // 64 per patterned pair (element_slots)

@@ -32,7 +32,7 @@ struct SmoothRelaxOptions {
     // Called with each accepted iterate of the relaxation, over all its rounds (SolverOptions::observe); empty: none.
     std::function<void(const Eigen::VectorXd& q, double energy, double grad_max)> observe;
     // Called between the local solves of a global iteration (SolverOptions::observe_within); empty: none.
-    std::function<void(const Eigen::VectorXd& q, const std::function<double()>& energy)> observe_within;
+    WithinObserver observe_within;
 };
 
 struct SmoothRelaxResult {

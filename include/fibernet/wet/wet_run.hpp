@@ -53,7 +53,7 @@ struct WetRunOptions {
     // free box's relaxations), e.g. to write checkpoints (SolverOptions::observe); empty: none.
     std::function<void(const Eigen::VectorXd& q, double energy, double grad_max)> observe_wet;
     // The same relaxation between the local solves of an iteration (SolverOptions::observe_within); empty: none.
-    std::function<void(const Eigen::VectorXd& q, const std::function<double()>& energy)> observe_wet_within;
+    WithinObserver observe_wet_within;
 };
 
 struct WetState {
