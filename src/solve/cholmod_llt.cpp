@@ -6,6 +6,8 @@
 #include <stdexcept>
 
 #include "cholmod_view.hpp"
+#include "fibernet/util/blas_threads.hpp"
+#include "fibernet/util/inline_openmp.hpp"
 
 namespace fibernet {
 
@@ -14,6 +16,7 @@ struct CholmodLLT::Impl {
     cholmod_factor* L = nullptr;
     int n = -1;
     long nnz = -1;
+    double flops = 0;  // of a numeric factorization, from the analysis
     bool ok = false;
 
     Impl() {
@@ -46,10 +49,12 @@ void CholmodLLT::forget() {
 void CholmodLLT::analyze(const Eigen::SparseMatrix<double>& upper) {
     if (impl_->L) cholmod_free_factor(&impl_->L, &impl_->c);
     cholmod_sparse A = view(upper);
+    const InlineOpenMP on_this_thread;
     impl_->L = cholmod_analyze(&A, &impl_->c);
     if (!impl_->L) throw std::runtime_error("CHOLMOD symbolic analysis failed (status " + std::to_string(impl_->c.status) + ")");
     impl_->n = static_cast<int>(upper.rows());
     impl_->nnz = static_cast<long>(upper.nonZeros());
+    impl_->flops = impl_->c.fl;
     impl_->ok = false;
 }
 
@@ -60,6 +65,8 @@ bool CholmodLLT::factorize(const Eigen::SparseMatrix<double>& upper, double shif
     cholmod_sparse A = view(upper);
     double beta[2] = {shift, 0.0};
     impl_->c.status = CHOLMOD_OK;
+    const InlineOpenMP on_this_thread;  // its supernodal memory passes (inline_openmp.hpp)
+    const BlasThreads blas(impl_->flops);
     const int r = cholmod_factorize_p(&A, beta, nullptr, 0, impl_->L, &impl_->c);
     impl_->ok = r && impl_->c.status == CHOLMOD_OK && impl_->L->minor == impl_->L->n;
     return impl_->ok;
@@ -81,6 +88,8 @@ Eigen::MatrixXd CholmodLLT::solve_many(const Eigen::MatrixXd& b) const {
     B.x = const_cast<double*>(b.data());
     B.xtype = CHOLMOD_REAL;
     B.dtype = CHOLMOD_DOUBLE;
+    const InlineOpenMP on_this_thread;
+    const BlasThreads blas(impl_->flops);
     cholmod_dense* X = cholmod_solve(CHOLMOD_A, impl_->L, &B, &impl_->c);
     if (!X) throw std::runtime_error("CHOLMOD solve failed (status " + std::to_string(impl_->c.status) + ")");
     std::copy(static_cast<double*>(X->x), static_cast<double*>(X->x) + b.size(), x.data());

@@ -13,6 +13,7 @@ namespace fibernet {
 
 namespace {
 std::atomic<int> override_count{0};
+thread_local bool parallel_section = false;
 
 // fibernet has no OpenMP loop of its own; CHOLMOD's supernodal factorization has, and asks for a number of threads
 // fixed when it was built (CHOLMOD_OMP_NUM_THREADS, 4 in Debian's), whatever OMP_NUM_THREADS says. On one thread,
@@ -24,6 +25,11 @@ void openmp_for(int threads) {
     omp_set_max_active_levels(threads == 1 ? 0 : initial);
 }
 }  // namespace
+
+bool in_parallel_section() { return parallel_section; }
+
+ParallelSection::ParallelSection() : outer_(parallel_section) { parallel_section = true; }
+ParallelSection::~ParallelSection() { parallel_section = outer_; }
 
 void set_thread_count(int n) {
     if (n < 0) throw std::invalid_argument("set_thread_count: n = " + std::to_string(n) + " must be >= 0");

@@ -6,6 +6,10 @@
 
 #include "cholmod_fixtures.hpp"
 #include "fibernet/solve/cholmod_llt.hpp"
+#include "fibernet/util/blas_threads.hpp"
+#include "fibernet/util/parallel.hpp"
+
+extern "C" void openblas_set_num_threads(int);
 
 using namespace fibernet;
 
@@ -37,4 +41,23 @@ TEST_CASE("cholmod_llt: an indefinite matrix does not factor", "[cholmod_llt]") 
     CHECK_FALSE(llt.factorize(U, 0.0));
     CHECK_THROWS_AS(llt.solve(Eigen::VectorXd::Ones(U.rows())), std::logic_error);
     CHECK(llt.factorize(U, 10.0));  // shifted past the most negative eigenvalue
+}
+
+TEST_CASE("cholmod_llt: below the threaded size, the same solution bit for bit on one thread and on two",
+          "[cholmod_llt]") {
+    // OpenBLAS's threaded kernels round differently from its serial ones; BlasThreads (util/blas_threads.hpp) keeps a
+    // factorization of fewer than kThreadedFlops operations on one thread whatever fibernet's or OpenBLAS's count.
+    const Eigen::SparseMatrix<double> U = grid(60, 4.1, 0.0);
+    Eigen::VectorXd b(U.rows());
+    for (Eigen::Index i = 0; i < b.size(); ++i) b[i] = std::sin(0.37 * static_cast<double>(i)) + 0.5;
+    std::vector<Eigen::VectorXd> x;
+    for (int threads : {1, 2}) {
+        set_thread_count(threads);
+        openblas_set_num_threads(BlasThreads::own());  // OpenBLAS's default, as a process starts
+        CholmodLLT llt;
+        REQUIRE(llt.factorize(U, 0.0));
+        x.push_back(llt.solve(b));
+    }
+    set_thread_count(0);
+    CHECK((x[0].array() == x[1].array()).all());
 }

@@ -18,6 +18,21 @@ int thread_count();
 void set_thread_count(int n);
 int thread_count_default();
 
+// Whether the calling thread is inside a parallel section of parallel_ranges or parallel_blocks with more than one
+// thread (its calling thread too): work there runs beside other work (blas_threads.hpp).
+bool in_parallel_section();
+// Marks the calling thread as inside a parallel section while it lives.
+class ParallelSection {
+public:
+    ParallelSection();
+    ~ParallelSection();
+    ParallelSection(const ParallelSection&) = delete;
+    ParallelSection& operator=(const ParallelSection&) = delete;
+
+private:
+    bool outer_;
+};
+
 // Calls body(lo, hi) on `threads` contiguous ranges covering [0, n), one per thread (the calling thread takes the
 // first). The first exception thrown by any range is rethrown here after all threads have finished.
 template <class Body>
@@ -29,6 +44,7 @@ void parallel_ranges(std::size_t n, int threads, Body body) {
     }
     std::vector<std::exception_ptr> errors(t);
     auto run = [&](std::size_t k) {
+        const ParallelSection section;
         try {
             body(n * k / t, n * (k + 1) / t);
         } catch (...) {
@@ -64,6 +80,7 @@ void parallel_blocks(std::size_t n, int threads, std::size_t block, First first,
     std::atomic<std::size_t> next{0};
     std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads));
     auto take = [&](std::size_t k, bool with_first) {
+        const ParallelSection section;
         try {
             if (with_first) first();
             for (;;) {

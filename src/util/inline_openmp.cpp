@@ -1,0 +1,37 @@
+#include "fibernet/util/inline_openmp.hpp"
+
+#include <dlfcn.h>
+
+#include <atomic>
+
+namespace fibernet {
+
+namespace {
+thread_local int guards = 0;
+std::atomic<long> inlined{0};
+std::atomic<bool> reached{false};
+}  // namespace
+
+InlineOpenMP::InlineOpenMP() { ++guards; }
+InlineOpenMP::~InlineOpenMP() { --guards; }
+
+long InlineOpenMP::regions_inlined() { return inlined.load(); }
+bool InlineOpenMP::in_effect() { return reached.load(); }
+
+}  // namespace fibernet
+
+// GCC's entry point of `#pragma omp parallel` (libgomp, symbol version GOMP_4.0). Under a guard the body runs here:
+// outside any team, omp_get_num_threads() is 1 and omp_get_thread_num() 0, so a static loop's one share is the whole
+// range, exactly as in a team of one. Otherwise libgomp's own entry point runs it.
+extern "C" __attribute__((visibility("default"))) void GOMP_parallel(void (*fn)(void*), void* data,
+                                                                     unsigned num_threads, unsigned flags) {
+    using Entry = void (*)(void (*)(void*), void*, unsigned, unsigned);
+    static const Entry gomp = reinterpret_cast<Entry>(dlvsym(RTLD_NEXT, "GOMP_parallel", "GOMP_4.0"));
+    fibernet::reached.store(true, std::memory_order_relaxed);
+    if (fibernet::guards > 0 || !gomp) {
+        if (fibernet::guards > 0) fibernet::inlined.fetch_add(1, std::memory_order_relaxed);
+        fn(data);
+        return;
+    }
+    gomp(fn, data, num_threads, flags);
+}
