@@ -5,6 +5,7 @@
 #include <cholmod.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <thread>
@@ -115,6 +116,33 @@ TEST_CASE("InlineOpenMP: under a guard a parallel region runs once, on the calli
     Region after;
     GOMP_parallel(body, &after, 2, 0);
     CHECK(after.bodies == 2);  // the guard is gone with its scope
+    set_thread_count(0);
+}
+
+namespace {
+struct Nested {
+    std::atomic<int> inner_bodies{0};
+    std::atomic<int> widest{0};
+};
+void inner(void* p) {
+    auto& n = *static_cast<Nested*>(p);
+    ++n.inner_bodies;
+    n.widest = std::max(n.widest.load(), omp_get_num_threads());
+}
+void outer(void* p) {
+    const InlineOpenMP guard;  // fibernet called from each thread of a program's own parallel region
+    GOMP_parallel(inner, p, 4, 0);
+}
+}  // namespace
+
+TEST_CASE("InlineOpenMP: a region under a guard on a thread of a larger team goes to OpenMP", "[util][openmp]") {
+    // Run inline there, the body would see the outer team's size and do only its share of a static loop.
+    set_thread_count(2);
+    Nested n;
+    GOMP_parallel(outer, &n, 2, 0);
+    // Each of the 2 outer threads gets a nested team (of one while nesting is off, OpenMP's default; of 4 with it on)
+    // whose bodies each see that team's size; inline, a body would see 2 and run once per outer thread.
+    CHECK(n.inner_bodies == 2 * n.widest);
     set_thread_count(0);
 }
 
