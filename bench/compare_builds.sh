@@ -12,17 +12,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 [ $# -eq 2 ] || { echo "usage: $0 BASE_EXE NEW_EXE" >&2; exit 2; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-strip() {
-    /usr/bin/python3 -c '
-import json, sys
-drop = {"seconds", "timings", "provenance", "command", "load"}
-def clean(o):
-    if isinstance(o, dict): return {k: clean(v) for k, v in o.items() if k not in drop}
-    if isinstance(o, list): return [clean(v) for v in o]
-    return o
-try: print(json.dumps(clean(json.load(sys.stdin)), indent=1, sort_keys=True))
-except Exception as e: print("no JSON:", e)'
-}
+strip() { /usr/bin/python3 "$root/bench/strip_timings.py"; }
 run_all() {
     local exe=$1 out=$2 s
     mkdir -p "$out"

@@ -15,18 +15,8 @@ shift 3
 for exe in "$base" "$new"; do [ -x "$exe" ] || { echo "$0: not an executable: $exe" >&2; exit 2; }; done
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-strip() {
-    /usr/bin/python3 -c '
-import json, sys
-drop = {"seconds", "timings", "provenance", "command", "load", "out_dir", "seconds_wet_solve"}
-def clean(o):
-    if isinstance(o, dict): return {k: clean(v) for k, v in o.items() if k not in drop and "seconds" not in k}
-    if isinstance(o, list): return [clean(v) for v in o]
-    return o
-text = sys.stdin.read()
-try: print(json.dumps(clean(json.loads(text)), indent=1, sort_keys=True))
-except Exception: print(text)'
-}
+strip_py=$(cd "$(dirname "$0")" && pwd)/strip_timings.py
+strip() { /usr/bin/python3 "$strip_py"; }
 for ((r = 1; r <= repeats; ++r)); do
     for b in base new; do
         exe=$base

@@ -45,10 +45,11 @@ int threads_of_this_process() {
     return n;
 }
 
-// The 5-point Laplacian of a 150 x 150 grid, shifted: positive definite, with supernodes of hundreds of rows (so
-// CHOLMOD's regions, which open above 128 rows or 1024 entries, do open).
+// The 5-point Laplacian of a 40 x 40 grid, shifted: positive definite, with more than 128 rows and supernodes of more
+// than 1024 entries (so CHOLMOD's regions open), and few enough operations that OpenBLAS runs on one thread in both
+// factorizations compared (blas_threads.hpp; its threaded kernels round differently).
 Eigen::SparseMatrix<double> laplacian() {
-    const int m = 150, n = m * m;
+    const int m = 40, n = m * m;
     std::vector<Eigen::Triplet<double>> t;
     for (int i = 0; i < m; ++i)
         for (int j = 0; j < m; ++j) {
