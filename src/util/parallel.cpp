@@ -16,10 +16,11 @@ std::atomic<int> override_count{0};
 thread_local bool parallel_section = false;
 
 // fibernet has no OpenMP loop of its own; CHOLMOD's supernodal factorization has, and asks for a number of threads
-// fixed when it was built (CHOLMOD_OMP_NUM_THREADS, 4 in Debian's), whatever OMP_NUM_THREADS says. On one thread,
-// OpenMP's teams are turned off instead (max-active-levels 0: a parallel region runs on the thread that meets it), so
-// that a single-threaded run or a scan's rank does not wake 3 more threads per supernode (docs/benchmarks.md,
-// "CHOLMOD's OpenMP threads"). More threads: OpenMP's own setting, as the process started with it.
+// fixed when it was built (CHOLMOD_OMP_NUM_THREADS, 4 in Debian's), whatever OMP_NUM_THREADS says. fibernet's own
+// CHOLMOD calls run those regions inline (inline_openmp.hpp); for any other region (a loader that bound CHOLMOD to
+// libgomp directly, another library), on one thread OpenMP's teams are turned off (max-active-levels 0: a parallel
+// region runs on the thread that meets it), so that a single-threaded run or a scan's rank starts no more threads.
+// More threads: OpenMP's own setting, as the process started with it.
 void openmp_for(int threads) {
     static const int initial = omp_get_max_active_levels();
     omp_set_max_active_levels(threads == 1 ? 0 : initial);
