@@ -10,14 +10,12 @@ namespace fibernet {
 namespace {
 thread_local int guards = 0;
 std::atomic<long> inlined{0};
-std::atomic<bool> reached{false};
 }  // namespace
 
 InlineOpenMP::InlineOpenMP() { ++guards; }
 InlineOpenMP::~InlineOpenMP() { --guards; }
 
 long InlineOpenMP::regions_inlined() { return inlined.load(); }
-bool InlineOpenMP::in_effect() { return reached.load(); }
 
 }  // namespace fibernet
 
@@ -30,7 +28,6 @@ extern "C" __attribute__((visibility("default"))) void GOMP_parallel(void (*fn)(
                                                                      unsigned num_threads, unsigned flags) {
     using Entry = void (*)(void (*)(void*), void*, unsigned, unsigned);
     static const Entry gomp = reinterpret_cast<Entry>(dlvsym(RTLD_NEXT, "GOMP_parallel", "GOMP_4.0"));
-    fibernet::reached.store(true, std::memory_order_relaxed);
     if ((fibernet::guards > 0 && omp_get_num_threads() == 1) || !gomp) {
         if (fibernet::guards > 0) fibernet::inlined.fetch_add(1, std::memory_order_relaxed);
         fn(data);

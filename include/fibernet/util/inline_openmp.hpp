@@ -21,10 +21,9 @@ public:
     InlineOpenMP(const InlineOpenMP&) = delete;
     InlineOpenMP& operator=(const InlineOpenMP&) = delete;
 
-    // Parallel regions run on their calling thread under a guard since the process started, and whether this
-    // process's OpenMP calls reach fibernet's entry point at all (false where a loader bound them to libgomp's).
+    // Parallel regions run on their calling thread under a guard since the process started (none where a loader
+    // bound the libraries' calls to libgomp's entry point instead of fibernet's).
     static long regions_inlined();
-    static bool in_effect();
 };
 
 }  // namespace fibernet
