@@ -782,6 +782,9 @@ private:
         gmax = g_.size() ? g_.cwiseAbs().maxCoeff() : 0.0;
         r_.seconds_gradient += now() - tg;
         bool equilibrium = r_.last.converged() && gmax <= r_.last.grad_max * (1 + 1e-9);
+        // A bridge formed without a torque at q (fibers crossing nearly parallel) leaves q an equilibrium but changes
+        // the energy: the result's energy is the final set's.
+        if (equilibrium && !changed.empty()) r_.last.energy = Wn.value(q_);
         // After a local round the set was updated only where nodes moved, but a rule that depends on the state being
         // an equilibrium (the rupture of nearly parallel pairs out of contact) applies everywhere: a global round (no
         // Newton step at an equilibrium, then a full update) decides.

@@ -383,9 +383,10 @@ double bridge_element_energy(const BridgeElement& e, const Vector16d& X, double 
         if (hess) {
             // J^T V_gg J + J^T C + C^T J = T + T^T with T = J^T K, K = V_gg J / 2 + C (V_gg symmetric).
             Eigen::Matrix<double, 8, 16> K = C;
+            const Eigen::Matrix<double, 8, 8> Vgg = V.hessian();
             for (int l = 0; l < 8; ++l)
                 if (e.node[l] >= 0)
-                    for (int c = 0; c < 6; ++c) K.col(dist[l].col[c]) += (0.5 * dist[l].g[c]) * V.h.col(l);
+                    for (int c = 0; c < 6; ++c) K.col(dist[l].col[c]) += (0.5 * dist[l].g[c]) * Vgg.col(l);
             Matrix16d Tt = Matrix16d::Zero();  // T^T = K^T J
             for (int k = 0; k < 8; ++k)
                 if (e.node[k] >= 0)
@@ -450,7 +451,7 @@ double bridge_element_energy_reference(const BridgeElement& e, const Vector16d& 
             if (grad) *grad += eij * Wij.g + Wij.v * G;
             if (hess) {
                 if (blended) {
-                    *hess += eij * Wij.h + Wij.g * G.transpose() + G * Wij.g.transpose() +
+                    *hess += eij * Wij.hessian() + Wij.g * G.transpose() + G * Wij.g.transpose() +
                              A.transpose() * (Wij.v * H4) * A;
                 } else {
                     const Eigen::Matrix4d h = Wij.v * H4;

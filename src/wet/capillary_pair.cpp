@@ -60,67 +60,91 @@ template <class T>
 T cross(const V2<T>& a, const V2<T>& b) { return a.x * b.y - a.y * b.x; }
 template <class T>
 V2<T> scaled(const V2<T>& a, const T& s) { return {a.x * s, a.y * s}; }
+template <class T>
+V2<double> values(const V2<T>& a) { return {value_of(a.x), value_of(a.y)}; }
 
-// The geometry both terms share, and which of them can be non-zero (decided on values, so that a vanishing term is
-// never differentiated).
 struct Consts {
     double eps, w, contact, s_lo, s_hi;
 };
 
+// The nodes, the segments and what both terms need of them. X is the pair relative to p0 (relative() below): p0 = 0,
+// so the differences from p0 below are the points themselves (the same numbers, without their jets' operations).
 template <class T>
 struct Geometry {
     V2<T> p0, p1, q0, q1, d1, d2;
-    T L1s, L2s, cr, dt, s;  // |d1|^2, |d2|^2, d1 x d2, d1.d2, sin^2
-    T blend;                // b(s)
+    T L1s, L2s, dt;  // |d1|^2, |d2|^2, d1.d2
 };
 
 template <class T>
-Geometry<T> geometry(const T* X, const Consts& k) {
+Geometry<T> geometry(const T* X) {
     Geometry<T> G;
     G.p0 = {X[0], X[1]}, G.p1 = {X[2], X[3]}, G.q0 = {X[4], X[5]}, G.q1 = {X[6], X[7]};
-    G.d1 = G.p1 - G.p0, G.d2 = G.q1 - G.q0;
+    G.d1 = G.p1, G.d2 = G.q1 - G.q0;
     G.L1s = dot(G.d1, G.d1), G.L2s = dot(G.d2, G.d2);
-    G.cr = cross(G.d1, G.d2), G.dt = dot(G.d1, G.d2);
-    G.s = G.cr * G.cr * rcp(G.L1s * G.L2s);
-    G.blend = step(2.0 * (G.s - k.s_lo) / (k.s_hi - k.s_lo) - 1.0);
+    G.dt = dot(G.d1, G.d2);
     return G;
 }
 
-// W_A W_B (capillary_pair.hpp).
+// The pair in doubles: every factor's value and the argument of each smoothing it passes through. The derivative pass
+// (terms<Jet>) differentiates only the factors whose smoothing is inside its window here; outside, a step is exactly 0
+// or 1 and D exactly 1 or 0, constants whose jets would be spent on zero derivatives (most crossings lie away from
+// both segments' nodes, most contacts within the contact distance and below angle_lo).
+struct Shape {
+    Geometry<double> G;
+    double cr = 0, s = 0;   // d1 x d2, sin^2
+    double blend_t = 0;     // the angle blend's argument; b(s) = step(blend_t)
+    double blend = 0;
+    double share_t[4] = {};  // W_A's two and W_B's two step arguments
+    double WA = 0, WB = 0;
+    double overlap = 0, delta = 0, D = 0;
+    bool crossing = false, contact = false;  // the terms that are non-zero
+};
+
+// W_A, W_B's step arguments: the signed distances of a's nodes to b's line and of b's nodes to a's line, over eps.
 template <class T>
-T crossing_shares(const Geometry<T>& G, const Consts& k) {
-    const double sg = value_of(G.cr) > 0 ? 1.0 : -1.0;
+void share_arguments(const Geometry<T>& G, const T& i1, const T& i2, const bool want[4], T t[4]) {
     const V2<T> n2{-G.d2.y, G.d2.x}, n1{-G.d1.y, G.d1.x};
-    const T i2 = rcp(k.eps * sqrt(G.L2s)), i1 = rcp(k.eps * sqrt(G.L1s));
-    const T WA = sg * (step(dot(G.p0 - G.q0, n2) * i2) - step(dot(G.p1 - G.q0, n2) * i2));
-    if (value_of(WA) == 0) return T(0.0);
-    const T WB = sg * (step(dot(G.q1 - G.p0, n1) * i1) - step(dot(G.q0 - G.p0, n1) * i1));
-    return WA * WB;
+    if (want[0]) t[0] = -dot(G.q0, n2) * i2;
+    if (want[1]) t[1] = dot(G.p1 - G.q0, n2) * i2;
+    if (want[2]) t[2] = dot(G.q1, n1) * i1;
+    if (want[3]) t[3] = dot(G.q0, n1) * i1;
 }
 
-// overlap and D(delta) of the contact term.
+// The contact term's bisector frame: overlap's four smoothed |x| / 2 arguments and the offset delta across e.
 template <class T>
-void contact_parts(const Geometry<T>& G, const Consts& k, T& overlap, T& D) {
-    const double sd = value_of(G.dt) >= 0 ? 1.0 : -1.0;
+struct ContactFrame {
+    T a1, c0, c1;  // a's far end, b's two ends on e (a's near end is 0)
+    V2<T> e;
+};
+
+template <class T>
+ContactFrame<T> contact_frame(const Geometry<T>& G, double sd) {
     const T i1 = rcp(sqrt(G.L1s)), i2 = sd * rcp(sqrt(G.L2s));
     V2<T> e = scaled(G.d1, i1) + scaled(G.d2, i2);
     const T ie = rcp(sqrt(dot(e, e)));
-    e = scaled(e, ie);
-    const T a1 = dot(G.d1, e), b0 = dot(G.q0 - G.p0, e), b1 = dot(G.q1 - G.p0, e);
-    const T c0 = sd > 0 ? b0 : b1, c1 = sd > 0 ? b1 : b0;
-    const double a1v = value_of(a1), c0v = value_of(c0), c1v = value_of(c1);
-    if (c0v >= a1v + k.w || c1v <= -k.w) {  // apart by at least w: exactly no overlap
-        overlap = T(0.0), D = T(0.0);
-        return;
-    }
-    const T zero(0.0);
-    overlap = half_abs(zero - c1, k.w) + half_abs(a1 - c0, k.w) - half_abs(zero - c0, k.w) - half_abs(a1 - c1, k.w);
-    const V2<T> n{-e.y, e.x};
-    const T delta = 0.5 * dot((G.q0 + G.q1) - (G.p0 + G.p1), n);
-    const double dv = std::abs(value_of(delta));
-    if (dv <= k.contact) D = T(1.0);
-    else if (dv >= 1.5 * k.contact) D = T(0.0);
-    else D = 1.0 - step(4.0 * (sqrt(delta * delta) - k.contact) / k.contact - 1.0);
+    ContactFrame<T> f;
+    f.e = scaled(e, ie);
+    f.a1 = dot(G.d1, f.e);
+    const T b0 = dot(G.q0, f.e), b1 = dot(G.q1, f.e);
+    f.c0 = sd > 0 ? b0 : b1, f.c1 = sd > 0 ? b1 : b0;
+    return f;
+}
+
+template <class T>
+T overlap_of(const ContactFrame<T>& f, double w) {
+    // A(a0 - c1) + A(a1 - c0) - A(a0 - c0) - A(a1 - c1) with a0 = 0, and A even.
+    return half_abs(f.c1, w) + half_abs(f.a1 - f.c0, w) - half_abs(f.c0, w) - half_abs(f.a1 - f.c1, w);
+}
+
+template <class T>
+T offset_of(const Geometry<T>& G, const ContactFrame<T>& f) {
+    const V2<T> n{-f.e.y, f.e.x};
+    return 0.5 * dot((G.q0 + G.q1) - G.p1, n);
+}
+
+template <class T>
+T fade_of(const T& delta, double contact) {  // D(delta) inside its window
+    return 1.0 - step(4.0 * (sqrt(delta * delta) - contact) / contact - 1.0);
 }
 
 Consts consts(const CapillaryPairParams& p) {
@@ -133,43 +157,127 @@ Consts consts(const CapillaryPairParams& p) {
     return {p.crossing_width, p.overlap_width, p.contact, s_lo, s_hi};
 }
 
-// Which terms can be non-zero at X (values only).
-struct Active {
-    bool crossing = false, contact = false;
-};
-Active active_terms(const double* X, bool wet_crossing, const Consts& k, CapillaryPairParts* parts) {
-    const Geometry<double> G = geometry(X, k);
-    Active a;
-    if (parts) parts->sin2 = G.s;
-    if (wet_crossing && G.blend > 0) {
-        const double w = crossing_shares(G, k);
-        a.crossing = w != 0;
-        if (parts) parts->crossing_weight = G.blend * w;
-    }
-    if (G.blend < 1) {
-        double ov, D;
-        contact_parts(G, k, ov, D);
-        a.contact = ov != 0 && D != 0;
-        if (parts) parts->contact_weight = (1 - G.blend) * D, parts->overlap = ov;
-    }
-    return a;
+void crossing_shape(Shape& S, const Consts& k) {
+    const Geometry<double>& G = S.G;
+    const bool all[4] = {true, true, true, true};
+    share_arguments(G, 1 / (k.eps * std::sqrt(G.L1s)), 1 / (k.eps * std::sqrt(G.L2s)), all, S.share_t);
+    const double sg = S.cr > 0 ? 1.0 : -1.0;
+    S.WA = sg * (step(S.share_t[0]) - step(S.share_t[1]));
+    if (S.WA == 0) return;
+    S.WB = sg * (step(S.share_t[2]) - step(S.share_t[3]));
 }
 
-// The active terms' energies.
-template <class T>
-void terms(const T* X, double lbar, const CapillaryPairParams& p, const Consts& k, Active a, T& Ex, T& Ec) {
-    const Geometry<T> G = geometry(X, k);
-    Ex = T(0.0), Ec = T(0.0);
-    if (a.crossing) {
-        const T c = G.dt * G.dt * rcp(G.L1s * G.L2s);
-        double phi, dphi, d2phi;
-        p.law.eval(value_of(c), phi, dphi, d2phi);
-        Ex = (p.beta * lbar) * lift(c, phi, dphi, d2phi) * crossing_shares(G, k) * G.blend;
+void contact_shape(Shape& S, const Consts& k) {
+    const double sd = S.G.dt >= 0 ? 1.0 : -1.0;
+    const ContactFrame<double> f = contact_frame(S.G, sd);
+    if (f.c0 >= f.a1 + k.w || f.c1 <= -k.w) return;  // apart by at least w: exactly no overlap
+    S.overlap = overlap_of(f, k.w);
+    S.delta = offset_of(S.G, f);
+    const double dv = std::abs(S.delta);
+    S.D = dv <= k.contact ? 1.0 : dv >= 1.5 * k.contact ? 0.0 : fade_of(S.delta, k.contact);
+}
+
+Shape shape(const double* X, bool wet_crossing, const Consts& k) {
+    Shape S;
+    S.G = geometry(X);
+    S.cr = cross(S.G.d1, S.G.d2);
+    S.s = S.cr * S.cr * (1 / (S.G.L1s * S.G.L2s));
+    S.blend_t = 2.0 * (S.s - k.s_lo) / (k.s_hi - k.s_lo) - 1.0;
+    S.blend = step(S.blend_t);
+    if (wet_crossing && S.blend > 0) {
+        crossing_shape(S, k);
+        S.crossing = S.WA * S.WB != 0;
     }
-    if (a.contact) {
-        T ov, D;
-        contact_parts(G, k, ov, D);
-        Ec = (-p.beta) * ov * D * (1.0 - G.blend);
+    if (S.blend < 1) {
+        contact_shape(S, k);
+        S.contact = S.overlap != 0 && S.D != 0;
+    }
+    return S;
+}
+
+// A factor of a term: a jet where it varies, its value where it is constant.
+struct Factor {
+    bool constant = true;
+    double value = 0;
+    J jet;
+};
+J times(const J& a, const Factor& f) {
+    if (!f.constant) return a * f.jet;
+    return f.value == 1 ? a : f.value * a;
+}
+Factor varying(const J& j) {
+    Factor f;
+    f.constant = false, f.value = j.v, f.jet = j;
+    return f;
+}
+Factor constant(double v) {
+    Factor f;
+    f.value = v;
+    return f;
+}
+
+// The angle blend b(s) (its jet only inside the blend).
+Factor blend_factor(const Geometry<J>& G, const Shape& S, const Consts& k) {
+    if (S.blend_t <= -1 || S.blend_t >= 1) return constant(S.blend);
+    const J cr = cross(G.d1, G.d2);
+    const J s = cr * cr * rcp(G.L1s * G.L2s);
+    return varying(step(2.0 * (s - k.s_lo) / (k.s_hi - k.s_lo) - 1.0));
+}
+
+// W_A W_B (capillary_pair.hpp), differentiating only the steps inside their windows.
+Factor shares_factor(const Geometry<J>& G, const Shape& S, const Consts& k) {
+    bool want[4];
+    bool any = false;
+    for (int i = 0; i < 4; ++i) any |= want[i] = std::abs(S.share_t[i]) < 1;
+    if (!any) return constant(S.WA * S.WB);
+    J t[4];
+    const J i2 = rcp(k.eps * sqrt(G.L2s)), i1 = rcp(k.eps * sqrt(G.L1s));
+    share_arguments(G, i1, i2, want, t);
+    const double sg = S.cr > 0 ? 1.0 : -1.0;
+    auto H = [&](int i) { return want[i] ? step(t[i]) : J(step(S.share_t[i])); };
+    const J WA = sg * (H(0) - H(1));
+    const J WB = sg * (H(2) - H(3));
+    return varying(WA * WB);
+}
+
+// The contact term's overlap and D(delta) (D's jet only inside its fade).
+void contact_factors(const Geometry<J>& G, const Shape& S, const Consts& k, J& overlap, Factor& D) {
+    const double sd = S.G.dt >= 0 ? 1.0 : -1.0;
+    const ContactFrame<J> f = contact_frame(G, sd);
+    overlap = overlap_of(f, k.w);
+    const double dv = std::abs(S.delta);
+    D = dv <= k.contact || dv >= 1.5 * k.contact ? constant(S.D) : varying(fade_of(offset_of(G, f), k.contact));
+}
+
+// The active terms' energies in doubles (the same arithmetic as their jets' values).
+void terms(const Shape& S, double lbar, const CapillaryPairParams& p, double& Ex, double& Ec) {
+    Ex = 0, Ec = 0;
+    if (S.crossing) {
+        const Geometry<double>& G = S.G;
+        const double c = G.dt * G.dt * (1 / (G.L1s * G.L2s));
+        double phi, dphi, d2phi;
+        p.law.eval(c, phi, dphi, d2phi);
+        Ex = (p.beta * lbar) * phi * (S.WA * S.WB) * S.blend;
+    }
+    if (S.contact) Ec = (-p.beta) * S.overlap * S.D * (1.0 - S.blend);
+}
+
+void terms(const J* X, const Shape& S, double lbar, const CapillaryPairParams& p, const Consts& k, J& Ex, J& Ec) {
+    const Geometry<J> G = geometry(X);
+    Ex = J(0.0), Ec = J(0.0);
+    const Factor b = S.crossing || S.contact ? blend_factor(G, S, k) : constant(0);
+    if (S.crossing) {
+        const J c = G.dt * G.dt * rcp(G.L1s * G.L2s);
+        double phi, dphi, d2phi;
+        p.law.eval(c.v, phi, dphi, d2phi);
+        Ex = times(times((p.beta * lbar) * apply(c, phi, dphi, d2phi), shares_factor(G, S, k)), b);
+    }
+    if (S.contact) {
+        J ov;
+        Factor D;
+        contact_factors(G, S, k, ov, D);
+        const Factor one_minus_b = b.constant ? constant(1.0 - b.value) : varying(1.0 - b.jet);
+        Ec = times(times((-p.beta) * ov, D), one_minus_b);
     }
 }
 
@@ -227,8 +335,8 @@ Matrix8d to_pair(const Matrix6d& Hy) {
 }  // namespace
 
 bool capillary_pair_vanishes(const Vector8d& X, bool wet_crossing, const CapillaryPairParams& p) {
-    const Active a = active_terms(relative(X).data(), wet_crossing, consts(p), nullptr);
-    return !a.crossing && !a.contact;
+    const Shape S = shape(relative(X).data(), wet_crossing, consts(p));
+    return !S.crossing && !S.contact;
 }
 
 double capillary_pair_energy(const Vector8d& X, double l0a, double l0b, bool wet_crossing,
@@ -236,15 +344,20 @@ double capillary_pair_energy(const Vector8d& X, double l0a, double l0b, bool wet
                              CapillaryPairParts* parts, double contact_scale, Vector8d* contact_grad) {
     const Consts k = consts(p);
     const Vector8d Y = relative(X);
-    const Active a = active_terms(Y.data(), wet_crossing, k, parts);
+    const Shape S = shape(Y.data(), wet_crossing, k);
+    if (parts) {
+        parts->sin2 = S.s;
+        if (wet_crossing && S.blend > 0) parts->crossing_weight = S.blend * (S.WA * S.WB);
+        if (S.blend < 1) parts->contact_weight = (1 - S.blend) * S.D, parts->overlap = S.overlap;
+    }
     const double lbar = 0.5 * (l0a + l0b);
     if (grad) grad->setZero();
     if (hess) hess->setZero();
     if (contact_grad) contact_grad->setZero();
-    if (!a.crossing && !a.contact) return 0;
+    if (!S.crossing && !S.contact) return 0;
     if (!grad && !hess && !contact_grad) {
         double Ex, Ec;
-        terms(Y.data(), lbar, p, k, a, Ex, Ec);
+        terms(S, lbar, p, Ex, Ec);
         if (parts) parts->crossing_energy = Ex, parts->contact_energy = Ec;
         return contact_scale == 1 ? Ex + Ec : Ex + contact_scale * Ec;
     }
@@ -252,13 +365,13 @@ double capillary_pair_energy(const Vector8d& X, double l0a, double l0b, bool wet
     Yj[0] = J(0.0), Yj[1] = J(0.0);
     for (int i = 0; i < 6; ++i) Yj[2 + i] = J::variable(Y[2 + i], i);
     J Ex, Ec;
-    terms(Yj, lbar, p, k, a, Ex, Ec);
+    terms(Yj, S, lbar, p, k, Ex, Ec);
     if (parts) parts->crossing_energy = Ex.v, parts->contact_energy = Ec.v;
     if (contact_grad) *contact_grad = to_pair(Ec.g);
     const J E = contact_scale == 1 ? Ex + Ec : Ex + contact_scale * Ec;
     if (grad) *grad = to_pair(E.g);
     if (hess) {
-        Matrix6d Hy = 0.5 * (E.h + E.h.transpose());
+        Matrix6d Hy = E.hessian();
         if (project_psd) {
             Eigen::SelfAdjointEigenSolver<Matrix6d> es(Hy);
             const Vector6d ev = es.eigenvalues().cwiseMax(0.0);

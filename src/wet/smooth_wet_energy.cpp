@@ -165,31 +165,31 @@ void SmoothWetEnergy::cover(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, 
     if (!same_pattern(H, pattern_)) H = pattern_;
 }
 
+SmoothWetEnergy::SegmentBox SmoothWetEnergy::segment_box(int s, const Eigen::VectorXd& x,
+                                                        const Eigen::Matrix2d& B) const {
+    const Segment& a = dry_.model().segments[s];
+    const Eigen::Vector2d p0 = x.segment<2>(2 * a.i), p1 = x.segment<2>(2 * a.j) + B * a.shift.cast<double>();
+    return {std::min(p0.x(), p1.x()), std::max(p0.x(), p1.x()), std::min(p0.y(), p1.y()), std::max(p0.y(), p1.y()),
+            (p1 - p0).norm()};
+}
+
+bool SmoothWetEnergy::apart(const SegmentBox& a, const SegmentBox& b, const Eigen::Vector2d& t) const {
+    const double gx = std::max({0.0, b.x0 + t.x() - a.x1, a.x0 - b.x1 - t.x()});
+    const double gy = std::max({0.0, b.y0 + t.y() - a.y1, a.y0 - b.y1 - t.y()});
+    const double support = support_distance(std::max(a.length, b.length));
+    return gx * gx + gy * gy > support * support;
+}
+
 std::vector<int> SmoothWetEnergy::nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const {
     const std::vector<SegmentPair>& P = list_.pairs();
-    // Each segment's bounding box and length once, so that most listed pairs (far from their support at any one
-    // state) are set aside by two boxes and an image offset (the test of beyond_support, whose boxes these are).
-    const Model& m = dry_.model();
-    struct Box {
-        double x0, x1, y0, y1, length;
-    };
-    std::vector<Box> box(m.segments.size());
-    for (size_t s = 0; s < m.segments.size(); ++s) {
-        const Segment& a = m.segments[s];
-        const Eigen::Vector2d p0 = x.segment<2>(2 * a.i), p1 = x.segment<2>(2 * a.j) + B * a.shift.cast<double>();
-        box[s] = {std::min(p0.x(), p1.x()), std::max(p0.x(), p1.x()), std::min(p0.y(), p1.y()),
-                  std::max(p0.y(), p1.y()), (p1 - p0).norm()};
-    }
+    // Each segment's box once: most listed pairs (far from their support at any one state) are set aside by two boxes.
+    const size_t ns = dry_.model().segments.size();
+    std::vector<SegmentBox> box(ns);
+    for (size_t s = 0; s < ns; ++s) box[s] = segment_box(static_cast<int>(s), x, B);
     std::vector<char> on(P.size(), 0);
     parallel_ranges(P.size(), P.size() >= kParallelMin ? thread_count() : 1, [&](size_t lo, size_t hi) {
         for (size_t k = lo; k < hi; ++k) {
-            const Box& a = box[P[k].a];
-            const Box& b = box[P[k].b];
-            const Eigen::Vector2d t = B * P[k].image.cast<double>();
-            const double gx = std::max({0.0, b.x0 + t.x() - a.x1, a.x0 - b.x1 - t.x()});
-            const double gy = std::max({0.0, b.y0 + t.y() - a.y1, a.y0 - b.y1 - t.y()});
-            const double support = support_distance(std::max(a.length, b.length));
-            if (gx * gx + gy * gy > support * support) continue;
+            if (apart(box[P[k].a], box[P[k].b], B * P[k].image.cast<double>())) continue;
             on[k] = !capillary_pair_vanishes(list_.coordinates(P[k], x, B), wet_[k], params_.pair);
         }
     });

@@ -53,7 +53,7 @@ SmoothWetRegion::SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, co
     if (W_.capped()) {
         const CapState cs = cap_state(nonzero(), nullptr, nullptr);
         const double N = W_.params_.bundle_partners, h = kSaturationHalfWidth + 0.5;
-        std::vector<std::pair<int, int>> of_segment;  // (segment's place in cap_seg_, index into pairs_)
+        std::vector<std::pair<int, int>> of_segment;  // (segment's place in seg_, index into pairs_)
         for (int i : near) {
             const Vector8d X = W_.list_.coordinates(P[pairs_[i]], x_, B_);
             const Eigen::Vector2d d1 = X.segment<2>(2) - X.segment<2>(0), d2 = X.segment<2>(6) - X.segment<2>(4);
@@ -115,31 +115,32 @@ void SmoothWetRegion::take_pairs() {
         W_.list_.nodes(P[pairs_[i]], node, shift);
         for (int a = 0; a < 8; ++a) idx_[8 * i + a] = local(node[a / 2], a % 2);
     }
+    // The pairs' segments: the region's and their partners (the other segment of a moving pair).
+    seg_ = segs_;
+    for (int k : pairs_) seg_.push_back(P[k].a), seg_.push_back(P[k].b);
+    std::sort(seg_.begin(), seg_.end());
+    seg_.erase(std::unique(seg_.begin(), seg_.end()), seg_.end());
+    auto local_seg = [&](int s) {
+        return static_cast<int>(std::lower_bound(seg_.begin(), seg_.end(), s) - seg_.begin());
+    };
+    pair_seg_.resize(2 * pairs_.size());
+    for (size_t i = 0; i < pairs_.size(); ++i)
+        pair_seg_[2 * i] = local_seg(P[pairs_[i]].a), pair_seg_[2 * i + 1] = local_seg(P[pairs_[i]].b);
     list_build_ = W_.list_.builds();
     if (W_.capped()) take_cap_segments();
 }
 
 void SmoothWetRegion::take_cap_segments() {
-    // The segments whose n enters: the region's and their partners (the other segment of a moving pair). A partner's
-    // pairs with held segments do not change while the region moves: their contact energy is summed once here.
+    // The segments whose n enters are seg_. A partner's pairs with held segments do not change while the region moves:
+    // their contact energy is summed once here.
     const std::vector<SegmentPair>& P = W_.list_.pairs();
     const Model& m = W_.dry_.model();
     const CapillaryPairParams& pp = W_.params_.pair;
-    cap_seg_ = segs_;
-    for (int k : pairs_) cap_seg_.push_back(P[k].a), cap_seg_.push_back(P[k].b);
-    std::sort(cap_seg_.begin(), cap_seg_.end());
-    cap_seg_.erase(std::unique(cap_seg_.begin(), cap_seg_.end()), cap_seg_.end());
-    auto local_seg = [&](int s) {
-        return static_cast<int>(std::lower_bound(cap_seg_.begin(), cap_seg_.end(), s) - cap_seg_.begin());
-    };
-    pair_seg_.resize(2 * pairs_.size());
-    for (size_t i = 0; i < pairs_.size(); ++i)
-        pair_seg_[2 * i] = local_seg(P[pairs_[i]].a), pair_seg_[2 * i + 1] = local_seg(P[pairs_[i]].b);
-    fixed_C_.assign(cap_seg_.size(), 0.0);
+    fixed_C_.assign(seg_.size(), 0.0);
     const std::vector<int>& start = W_.seg_pair_start_;
     const std::vector<int>& list = W_.seg_pair_;
-    for (size_t j = 0; j < cap_seg_.size(); ++j) {
-        const int b = cap_seg_[j];
+    for (size_t j = 0; j < seg_.size(); ++j) {
+        const int b = seg_[j];
         if (in_region_[b]) continue;
         for (int p = start[b]; p < start[b + 1]; ++p) {
             const SegmentPair& pr = P[list[p]];
@@ -156,10 +157,13 @@ void SmoothWetRegion::take_cap_segments() {
 
 std::vector<int> SmoothWetRegion::nonzero() const {
     const std::vector<SegmentPair>& P = W_.list_.pairs();
+    box_.resize(seg_.size());
+    for (size_t j = 0; j < seg_.size(); ++j) box_[j] = W_.segment_box(seg_[j], x_, B_);
     std::vector<int> on;
     for (size_t i = 0; i < pairs_.size(); ++i) {
-        const Vector8d X = W_.list_.coordinates(P[pairs_[i]], x_, B_);
-        if (!W_.beyond_support(X) && !capillary_pair_vanishes(X, W_.wet_[pairs_[i]], W_.params_.pair))
+        const SegmentPair& p = P[pairs_[i]];
+        if (W_.apart(box_[pair_seg_[2 * i]], box_[pair_seg_[2 * i + 1]], B_ * p.image.cast<double>())) continue;
+        if (!capillary_pair_vanishes(W_.list_.coordinates(p, x_, B_), W_.wet_[pairs_[i]], W_.params_.pair))
             on.push_back(static_cast<int>(i));
     }
     return on;
@@ -190,15 +194,15 @@ SmoothWetRegion::CapState SmoothWetRegion::cap_state(const std::vector<int>& on,
         if (contact) (*contact)[j] = parts.contact_energy;
     }
     CapState cs;
-    cs.n.resize(cap_seg_.size()), cs.dS.resize(cap_seg_.size()), cs.kappa.assign(cap_seg_.size(), 0.0);
+    cs.n.resize(seg_.size()), cs.dS.resize(seg_.size()), cs.kappa.assign(seg_.size(), 0.0);
     double e = crossing;
-    for (size_t j = 0; j < cap_seg_.size(); ++j) {
-        const double l = m.segments[cap_seg_[j]].l0;
+    for (size_t j = 0; j < seg_.size(); ++j) {
+        const double l = m.segments[seg_[j]].l0;
         cs.n[j] = -C[j] / (beta * l);
         const Saturation st = bundle_saturation(cs.n[j], N);
         cs.dS[j] = st.dS, cs.kappa[j] = -st.d2S / (2 * beta * l);
         double share = -0.5 * beta * l * st.S;
-        if (!in_region_[cap_seg_[j]]) share -= -0.5 * beta * l * bundle_saturation(-fixed_C_[j] / (beta * l), N).S;
+        if (!in_region_[seg_[j]]) share -= -0.5 * beta * l * bundle_saturation(-fixed_C_[j] / (beta * l), N).S;
         e += share;
     }
     if (E) *E = e;
@@ -262,7 +266,7 @@ double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eige
     }
     if (!saturation) return E;
     // The cap's coupling kappa_s G_s G_s^T, G_s the gradient of s's contact energy over its moving pairs.
-    std::vector<std::vector<std::pair<int, double>>> G(cap_seg_.size());
+    std::vector<std::vector<std::pair<int, double>>> G(seg_.size());
     for (size_t j = 0; j < on.size(); ++j) {
         const int i = on[j];
         if (contact[j] == 0) continue;

@@ -158,7 +158,6 @@ TEST_CASE("smooth free box: capillary load moves the box to zero stress, its sti
     const Network net = mikado(2.5, 6, 0.8, 2);
     const Model m = model_of(net, 10);
     const FiberPairs dp = smooth_dry_pairs(net, {});
-    double E_capillary[2];
     for (int partners : {0, 1}) {
         INFO("bundle_partners " << partners);
         // beta = 0.05 put the uncapped free box of one OpenBLAS kernel (SkylakeX) within a strain of 2e-4 of a fold
@@ -167,7 +166,6 @@ TEST_CASE("smooth free box: capillary load moves the box to zero stress, its sti
         const WetRunOptions o = options(0.03, true, 1e-4, partners);
         const WetRun r = run_wet(net, m, Eigen::Matrix2d::Identity(), o);
         REQUIRE(r.wet.converged);
-        E_capillary[partners] = r.wet.energy.capillary;
         const FreeBoxResult& f = r.free_box;
         INFO(f.message << "; s = " << f.s << ", iterations " << f.iterations);
         REQUIRE(f.converged);
@@ -185,6 +183,14 @@ TEST_CASE("smooth free box: capillary load moves the box to zero stress, its sti
         // are short, so it stays on the free box's branch (with the skin's 0.5 it can leave it).
         REQUIRE(f.stiffness_eigenvalues.size() == 1);
         NetworkEnergy dry(m);
+        if (partners == 1) {
+            // The cap binds where the capped run ends: there the uncapped energy adheres more (5 % on this network).
+            // Compared at one state: which minimum the uncapped run itself ends in depends on its path (docs/wet.md).
+            SmoothWetEnergy capped(dry, f.F, p, dp, f.q), uncapped(dry, f.F, resolved(m, o.params.beta, 0), dp, f.q);
+            const double Ec = capped.split(f.q).capillary(), Eu = uncapped.split(f.q).capillary();
+            INFO("capillary energy at the capped free box: capped " << Ec << ", uncapped " << Eu);
+            CHECK(Ec > Eu + 0.01 * std::abs(Eu));
+        }
         auto solver = make_solver("newton", o.solver_options);
         SmoothRelaxOptions ro = o.smooth_relax;
         ro.max_step = 1e-3;
@@ -205,7 +211,6 @@ TEST_CASE("smooth free box: capillary load moves the box to zero stress, its sti
         CHECK(f.stiffness_eigenvalues[0] > 0);
         CHECK(f.stiffness_eigenvalues[0] == Approx(K_fd).epsilon(1e-4));
     }
-    CHECK(E_capillary[1] > E_capillary[0] + 0.05 * std::abs(E_capillary[0]));  // the cap binds on this network
 }
 
 TEST_CASE("smooth free box: full box under capillary load on a rigid network", "[wet][free_box][smooth]") {

@@ -152,6 +152,14 @@ private:
     double support_distance(double L) const;
     // Whether the pair at X is surely zero from its segments' bounding boxes alone (farther apart than the support).
     bool beyond_support(const Vector8d& X) const;
+    // A segment's bounding box and length at x, so that a pass over many pairs tests each pair by two boxes and its
+    // image offset (apart()) instead of gathering its coordinates.
+    struct SegmentBox {
+        double x0, x1, y0, y1, length;
+    };
+    SegmentBox segment_box(int s, const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
+    // beyond_support() from the boxes of a pair's segments a and b, b at the offset t (B times the pair's image).
+    bool apart(const SegmentBox& a, const SegmentBox& b, const Eigen::Vector2d& t) const;
     static std::uint64_t key(const SegmentPair& p);
     // Per segment, the indices of the listed pairs that hold it (compressed rows over the list now in use).
     void index_segment_pairs() const;

@@ -39,7 +39,8 @@ public:
 
 private:
     double eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) override;
-    // The moving pairs from W's list as it is now, and with the cap their segments (take_cap_segments).
+    // The moving pairs from W's list as it is now and their segments, and with the cap the held pairs' contact
+    // energies (take_cap_segments).
     void take_pairs();
     void take_cap_segments();
     void slot_pairs();  // slots_ and unpatterned_ for the pairs taken
@@ -69,10 +70,11 @@ private:
     std::vector<int> idx_;      // 8 per pair
     std::vector<int> slots_;    // 64 per pair: value slots of its block in pattern_ (-1: none)
     std::vector<char> unpatterned_;  // per pair: the pattern lacks part of its block
-    // The partner cap: the region's segments and their partners (ascending), per pair its two segments' places there,
-    // and per segment the contact energy of its pairs with held segments (0 for the region's own).
-    std::vector<int> cap_seg_, pair_seg_;
+    // The region's segments and their partners (ascending), per pair its two segments' places there; the partner
+    // cap's contact energy per such segment of its pairs with held segments (0 for the region's own).
+    std::vector<int> seg_, pair_seg_;
     std::vector<double> fixed_C_;
+    mutable std::vector<SmoothWetEnergy::SegmentBox> box_;  // per entry of seg_, at x_ (nonzero())
     int list_build_ = -1;
     Eigen::SparseMatrix<double> pattern_, dry_H_;
     std::vector<int> dry_slot_;
