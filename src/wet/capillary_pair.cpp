@@ -346,7 +346,7 @@ double capillary_pair_energy(const Vector8d& X, double l0a, double l0b, bool wet
     const Vector8d Y = relative(X);
     const Shape S = shape(Y.data(), wet_crossing, k);
     if (parts) {
-        parts->sin2 = S.s;
+        parts->sin2 = S.s, parts->nonzero = S.crossing || S.contact;
         if (wet_crossing && S.blend > 0) parts->crossing_weight = S.blend * (S.WA * S.WB);
         if (S.blend < 1) parts->contact_weight = (1 - S.blend) * S.D, parts->overlap = S.overlap;
     }

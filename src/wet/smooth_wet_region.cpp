@@ -51,7 +51,8 @@ SmoothWetRegion::SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, co
         el.insert(el.end(), &idx_[8 * i], &idx_[8 * i] + 8);
     }
     if (W_.capped()) {
-        const CapState cs = cap_state(nonzero(), nullptr, nullptr);
+        std::vector<int> on;
+        const CapState cs = cap_state(candidates(), on, nullptr, nullptr);
         const double N = W_.params_.bundle_partners, h = kSaturationHalfWidth + 0.5;
         std::vector<std::pair<int, int>> of_segment;  // (segment's place in seg_, index into pairs_)
         for (int i : near) {
@@ -155,21 +156,18 @@ void SmoothWetRegion::take_cap_segments() {
     }
 }
 
-std::vector<int> SmoothWetRegion::nonzero() const {
+std::vector<int> SmoothWetRegion::candidates() const {
     const std::vector<SegmentPair>& P = W_.list_.pairs();
     box_.resize(seg_.size());
     for (size_t j = 0; j < seg_.size(); ++j) box_[j] = W_.segment_box(seg_[j], x_, B_);
-    std::vector<int> on;
-    for (size_t i = 0; i < pairs_.size(); ++i) {
-        const SegmentPair& p = P[pairs_[i]];
-        if (W_.apart(box_[pair_seg_[2 * i]], box_[pair_seg_[2 * i + 1]], B_ * p.image.cast<double>())) continue;
-        if (!capillary_pair_vanishes(W_.list_.coordinates(p, x_, B_), W_.wet_[pairs_[i]], W_.params_.pair))
-            on.push_back(static_cast<int>(i));
-    }
-    return on;
+    std::vector<int> out;
+    for (size_t i = 0; i < pairs_.size(); ++i)
+        if (!W_.apart(box_[pair_seg_[2 * i]], box_[pair_seg_[2 * i + 1]], B_ * P[pairs_[i]].image.cast<double>()))
+            out.push_back(static_cast<int>(i));
+    return out;
 }
 
-SmoothWetRegion::CapState SmoothWetRegion::cap_state(const std::vector<int>& on, double* E,
+SmoothWetRegion::CapState SmoothWetRegion::cap_state(const std::vector<int>& cand, std::vector<int>& on, double* E,
                                                      std::vector<double>* contact) const {
     // n_s = -C_s / (beta l_s) over the cap's segments, C_s summed in list order; the energy is the whole capped
     // energy less a constant that does not depend on which pairs were taken: the crossing terms of the moving pairs,
@@ -182,16 +180,18 @@ SmoothWetRegion::CapState SmoothWetRegion::cap_state(const std::vector<int>& on,
     const int N = W_.params_.bundle_partners;
     std::vector<double> C = fixed_C_;
     double crossing = 0;
-    if (contact) contact->resize(on.size());
-    for (size_t j = 0; j < on.size(); ++j) {
-        const int i = on[j];
+    on.clear();
+    if (contact) contact->clear();
+    for (const int i : cand) {
         const SegmentPair& pr = P[pairs_[i]];
         CapillaryPairParts parts;
         capillary_pair_energy(W_.list_.coordinates(pr, x_, B_), m.segments[pr.a].l0, m.segments[pr.b].l0,
                               W_.wet_[pairs_[i]], pp, nullptr, nullptr, false, &parts);
+        if (!parts.nonzero) continue;
+        on.push_back(i);
         crossing += parts.crossing_energy;
         C[pair_seg_[2 * i]] += parts.contact_energy, C[pair_seg_[2 * i + 1]] += parts.contact_energy;
-        if (contact) (*contact)[j] = parts.contact_energy;
+        if (contact) contact->push_back(parts.contact_energy);
     }
     CapState cs;
     cs.n.resize(seg_.size()), cs.dS.resize(seg_.size()), cs.kappa.assign(seg_.size(), 0.0);
@@ -237,15 +237,21 @@ double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eige
     const std::vector<SegmentPair>& P = W_.list_.pairs();
     const Model& m = W_.dry_.model();
     const CapillaryPairParams& pp = W_.params_.pair;
-    const std::vector<int> on = nonzero();  // indices into pairs_
+    // The non-zero pairs (indices into pairs_); with the cap, its state over them.
+    const std::vector<int> cand = candidates();
     const bool capped = W_.capped();
+    std::vector<int> on;
     CapState cs;
     std::vector<double> contact;
     if (capped) {
         double Ecap = 0;
-        cs = cap_state(on, &Ecap, &contact);
+        cs = cap_state(cand, on, &Ecap, &contact);
         E += Ecap;
         if (!g && !H) return E;
+    } else {
+        for (const int i : cand)
+            if (!capillary_pair_vanishes(W_.list_.coordinates(P[pairs_[i]], x_, B_), W_.wet_[pairs_[i]], pp))
+                on.push_back(i);
     }
     bool saturation = false;
     for (double k : cs.kappa) saturation = saturation || (H && k != 0);

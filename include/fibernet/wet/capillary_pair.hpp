@@ -71,6 +71,7 @@ struct CapillaryPairParts {
     double crossing_weight = 0, contact_weight = 0, overlap = 0;
     double crossing_energy = 0, contact_energy = 0;
     double sin2 = 0;  // sin^2 alpha
+    bool nonzero = false;  // a term acts: the energy and its derivatives are not identically zero here
 };
 
 // X = (p0, p1, q0, q1). Value and, where non-null, gradient and Hessian in X. wet_crossing: the crossing term applies

@@ -45,15 +45,16 @@ private:
     void take_cap_segments();
     void slot_pairs();  // slots_ and unpatterned_ for the pairs taken
     void place(const Eigen::VectorXd& qa);  // the region's coordinates into x_
-    // The moving pairs that are non-zero at x_ (indices into pairs_).
-    std::vector<int> nonzero() const;
-    // The partner cap over the cap's segments (cap_seg_) at x_, from the non-zero moving pairs `on`: per segment n,
-    // S'(n) and the coupling kappa = -S''(n) / (2 beta l); E (if asked) gets the capped capillary energy of the region up
-    // to a constant, `contact` each pair's contact energy.
+    // The moving pairs whose segments' boxes lie within the support at x_ (indices into pairs_): a superset of the
+    // non-zero ones, which the pair term itself then tells (CapillaryPairParts::nonzero).
+    std::vector<int> candidates() const;
+    // The partner cap over the cap's segments (seg_) at x_, from the moving pairs `cand` (candidates()): `on` gets the
+    // non-zero ones and `contact` (if asked) each one's contact energy; per segment n, S'(n) and the coupling
+    // kappa = -S''(n) / (2 beta l); E (if asked) gets the capped capillary energy of the region up to a constant.
     struct CapState {
         std::vector<double> n, dS, kappa;
     };
-    CapState cap_state(const std::vector<int>& on, double* E, std::vector<double>* contact) const;
+    CapState cap_state(const std::vector<int>& cand, std::vector<int>& on, double* E, std::vector<double>* contact) const;
 
     SmoothWetEnergy& W_;
     std::vector<int> coords_, coord_x_;  // region coordinate -> coordinate of q, and its entry of x_
@@ -74,7 +75,7 @@ private:
     // cap's contact energy per such segment of its pairs with held segments (0 for the region's own).
     std::vector<int> seg_, pair_seg_;
     std::vector<double> fixed_C_;
-    mutable std::vector<SmoothWetEnergy::SegmentBox> box_;  // per entry of seg_, at x_ (nonzero())
+    mutable std::vector<SmoothWetEnergy::SegmentBox> box_;  // per entry of seg_, at x_ (candidates())
     int list_build_ = -1;
     Eigen::SparseMatrix<double> pattern_, dry_H_;
     std::vector<int> dry_slot_;
