@@ -252,8 +252,8 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
     // accepted trial).
     if (!(at_.builds == list_.builds() && at_.x.size() == x.size() && (at_.x.array() == x.array()).all())) {
         at_.x = x, at_.builds = list_.builds();
-        at_.on = nonzero_pairs(x, B);
-        at_.pc = capped() ? partner_cap(x, B, at_.on) : PartnerCap{};
+        if (capped()) at_.on = nonzero_pairs(x, B, at_.pc);
+        else at_.on = nonzero_pairs(x, B), at_.pc = PartnerCap{};
     }
     const std::vector<int>& on = at_.on;
     const PartnerCap& pc = at_.pc;
@@ -337,6 +337,42 @@ SmoothWetEnergy::PartnerCap SmoothWetEnergy::partner_cap(const Eigen::VectorXd& 
             Ex[i] = parts.crossing_energy, Ec[i] = parts.contact_energy;
         }
     });
+    return partner_cap(on, Ex, Ec);
+}
+
+std::vector<int> SmoothWetEnergy::nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+                                                PartnerCap& pc) const {
+    // nonzero_pairs() and partner_cap() in one pass: each listed pair within its boxes' support evaluated once, its
+    // values telling whether it acts.
+    const std::vector<SegmentPair>& P = list_.pairs();
+    const Model& m = dry_.model();
+    const size_t ns = m.segments.size();
+    std::vector<SegmentBox> box(ns);
+    for (size_t s = 0; s < ns; ++s) box[s] = segment_box(static_cast<int>(s), x, B);
+    std::vector<char> act(P.size(), 0);
+    std::vector<double> ex(P.size()), ec(P.size());
+    parallel_ranges(P.size(), P.size() >= kParallelMin ? thread_count() : 1, [&](size_t lo, size_t hi) {
+        for (size_t k = lo; k < hi; ++k) {
+            if (apart(box[P[k].a], box[P[k].b], B * P[k].image.cast<double>())) continue;
+            CapillaryPairParts parts;
+            capillary_pair_energy(list_.coordinates(P[k], x, B), m.segments[P[k].a].l0, m.segments[P[k].b].l0, wet_[k],
+                                  params_.pair, nullptr, nullptr, false, &parts);
+            act[k] = parts.nonzero, ex[k] = parts.crossing_energy, ec[k] = parts.contact_energy;
+        }
+    });
+    std::vector<int> on;
+    std::vector<double> Ex, Ec;
+    for (size_t k = 0; k < P.size(); ++k)
+        if (act[k]) on.push_back(static_cast<int>(k)), Ex.push_back(ex[k]), Ec.push_back(ec[k]);
+    pc = partner_cap(on, Ex, Ec);
+    return on;
+}
+
+SmoothWetEnergy::PartnerCap SmoothWetEnergy::partner_cap(const std::vector<int>& on, const std::vector<double>& Ex,
+                                                         const std::vector<double>& Ec) const {
+    const std::vector<SegmentPair>& P = list_.pairs();
+    const Model& m = dry_.model();
+    const size_t n = on.size();
     // C_a, summed in list order (the same for any thread count).
     PartnerCap pc;
     std::vector<double> C(m.segments.size(), 0.0), dS(m.segments.size(), 1.0);

@@ -131,6 +131,10 @@ private:
     };
     bool capped() const { return params_.bundle_partners > 0; }
     PartnerCap partner_cap(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on) const;
+    // The same from the non-zero pairs' crossing and contact energies (per entry of `on`).
+    PartnerCap partner_cap(const std::vector<int>& on, const std::vector<double>& Ex, const std::vector<double>& Ec) const;
+    // nonzero_pairs() with the partner cap over them (pc), each pair's values computed once.
+    std::vector<int> nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, PartnerCap& pc) const;
     // Per saturating segment: the entries of `on` whose pair holds it and has a contact term.
     std::vector<std::vector<int>> saturating_pairs(const PartnerCap& pc, const std::vector<int>& on) const;
     // Adds the cap's coupling of each saturating segment's partners, kappa_a G_a G_a^T with G_a the gradient of its
