@@ -13,7 +13,8 @@ namespace fibernet {
 namespace {
 
 // The pair's energy is invariant under translation: it is differentiated in the 6 coordinates of p1, q0, q1 relative to
-// p0 (Y below), whose jets carry 36 Hessian entries instead of 64, and mapped back by X -> Y's constant Jacobian T.
+// p0 (Y below), whose jets carry a 6 x 6 Hessian (21 entries packed) instead of an 8 x 8, and mapped back by X -> Y's
+// constant Jacobian T.
 using J = Jet<6>;
 
 // f(x) from f, f', f'' at x's value: the double itself, or the chain rule on a jet.
@@ -60,25 +61,23 @@ template <class T>
 T cross(const V2<T>& a, const V2<T>& b) { return a.x * b.y - a.y * b.x; }
 template <class T>
 V2<T> scaled(const V2<T>& a, const T& s) { return {a.x * s, a.y * s}; }
-template <class T>
-V2<double> values(const V2<T>& a) { return {value_of(a.x), value_of(a.y)}; }
 
 struct Consts {
     double eps, w, contact, s_lo, s_hi;
 };
 
 // The nodes, the segments and what both terms need of them. X is the pair relative to p0 (relative() below): p0 = 0,
-// so the differences from p0 below are the points themselves (the same numbers, without their jets' operations).
+// so differences from p0 are the points themselves (the same numbers, without their jets' operations).
 template <class T>
 struct Geometry {
-    V2<T> p0, p1, q0, q1, d1, d2;
+    V2<T> p1, q0, q1, d1, d2;
     T L1s, L2s, dt;  // |d1|^2, |d2|^2, d1.d2
 };
 
 template <class T>
 Geometry<T> geometry(const T* X) {
     Geometry<T> G;
-    G.p0 = {X[0], X[1]}, G.p1 = {X[2], X[3]}, G.q0 = {X[4], X[5]}, G.q1 = {X[6], X[7]};
+    G.p1 = {X[2], X[3]}, G.q0 = {X[4], X[5]}, G.q1 = {X[6], X[7]};
     G.d1 = G.p1, G.d2 = G.q1 - G.q0;
     G.L1s = dot(G.d1, G.d1), G.L2s = dot(G.d2, G.d2);
     G.dt = dot(G.d1, G.d2);
