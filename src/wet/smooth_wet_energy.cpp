@@ -143,8 +143,9 @@ void SmoothWetEnergy::rebuild(const Eigen::VectorXd& q) {
         list_.build(x, B);
     }
     index_wet();
-    const std::vector<int> on = nonzero_pairs(x, B);
-    new_pattern(x, B, on, capped() ? partner_cap(x, B, on).n : std::vector<double>{});
+    PartnerCap pc;
+    const std::vector<int> on = nonzero_pairs(x, B, capped() ? &pc : nullptr);
+    new_pattern(x, B, on, pc.n);
     indexed_build_ = list_.builds();  // wet_ and patterned_ index this build
 }
 
@@ -180,23 +181,39 @@ bool SmoothWetEnergy::apart(const SegmentBox& a, const SegmentBox& b, const Eige
     return gx * gx + gy * gy > support * support;
 }
 
-std::vector<int> SmoothWetEnergy::nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const {
+std::vector<int> SmoothWetEnergy::nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+                                                PartnerCap* pc) const {
     const std::vector<SegmentPair>& P = list_.pairs();
+    const Model& m = dry_.model();
     // Each segment's box once: most listed pairs (far from their support at any one state) are set aside by two boxes.
-    const size_t ns = dry_.model().segments.size();
-    std::vector<SegmentBox> box(ns);
-    for (size_t s = 0; s < ns; ++s) box[s] = segment_box(static_cast<int>(s), x, B);
-    std::vector<char> on(P.size(), 0);
+    std::vector<SegmentBox> box(m.segments.size());
+    for (size_t s = 0; s < box.size(); ++s) box[s] = segment_box(static_cast<int>(s), x, B);
+    // With the cap, each remaining pair's values at once (they tell whether it acts), so that none is evaluated twice.
+    std::vector<char> act(P.size(), 0);
+    std::vector<double> ex(pc ? P.size() : 0), ec(pc ? P.size() : 0);
     parallel_ranges(P.size(), P.size() >= kParallelMin ? thread_count() : 1, [&](size_t lo, size_t hi) {
         for (size_t k = lo; k < hi; ++k) {
             if (apart(box[P[k].a], box[P[k].b], B * P[k].image.cast<double>())) continue;
-            on[k] = !capillary_pair_vanishes(list_.coordinates(P[k], x, B), wet_[k], params_.pair);
+            const Vector8d X = list_.coordinates(P[k], x, B);
+            if (!pc) {
+                act[k] = !capillary_pair_vanishes(X, wet_[k], params_.pair);
+                continue;
+            }
+            CapillaryPairParts parts;
+            capillary_pair_energy(X, m.segments[P[k].a].l0, m.segments[P[k].b].l0, wet_[k], params_.pair, nullptr,
+                                  nullptr, false, &parts);
+            act[k] = parts.nonzero, ex[k] = parts.crossing_energy, ec[k] = parts.contact_energy;
         }
     });
-    std::vector<int> out;
-    for (size_t k = 0; k < P.size(); ++k)
-        if (on[k]) out.push_back(static_cast<int>(k));
-    return out;
+    std::vector<int> on;
+    std::vector<double> Ex, Ec;
+    for (size_t k = 0; k < P.size(); ++k) {
+        if (!act[k]) continue;
+        on.push_back(static_cast<int>(k));
+        if (pc) Ex.push_back(ex[k]), Ec.push_back(ec[k]);
+    }
+    if (pc) *pc = partner_cap(on, Ex, Ec);
+    return on;
 }
 
 void SmoothWetEnergy::build_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on,
@@ -252,8 +269,8 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
     // accepted trial).
     if (!(at_.builds == list_.builds() && at_.x.size() == x.size() && (at_.x.array() == x.array()).all())) {
         at_.x = x, at_.builds = list_.builds();
-        if (capped()) at_.on = nonzero_pairs(x, B, at_.pc);
-        else at_.on = nonzero_pairs(x, B), at_.pc = PartnerCap{};
+        at_.pc = PartnerCap{};
+        at_.on = nonzero_pairs(x, B, capped() ? &at_.pc : nullptr);
     }
     const std::vector<int>& on = at_.on;
     const PartnerCap& pc = at_.pc;
@@ -320,52 +337,6 @@ double SmoothWetEnergy::eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen
         retrying_ = false;
     }
     return E;
-}
-
-SmoothWetEnergy::PartnerCap SmoothWetEnergy::partner_cap(const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
-                                                         const std::vector<int>& on) const {
-    const std::vector<SegmentPair>& P = list_.pairs();
-    const Model& m = dry_.model();
-    const size_t n = on.size();
-    std::vector<double> Ex(n), Ec(n);
-    parallel_ranges(n, n >= 64 ? thread_count() : 1, [&](size_t lo, size_t hi) {
-        for (size_t i = lo; i < hi; ++i) {
-            const SegmentPair& p = P[on[i]];
-            CapillaryPairParts parts;
-            capillary_pair_energy(list_.coordinates(p, x, B), m.segments[p.a].l0, m.segments[p.b].l0, wet_[on[i]],
-                                  params_.pair, nullptr, nullptr, false, &parts);
-            Ex[i] = parts.crossing_energy, Ec[i] = parts.contact_energy;
-        }
-    });
-    return partner_cap(on, Ex, Ec);
-}
-
-std::vector<int> SmoothWetEnergy::nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
-                                                PartnerCap& pc) const {
-    // nonzero_pairs() and partner_cap() in one pass: each listed pair within its boxes' support evaluated once, its
-    // values telling whether it acts.
-    const std::vector<SegmentPair>& P = list_.pairs();
-    const Model& m = dry_.model();
-    const size_t ns = m.segments.size();
-    std::vector<SegmentBox> box(ns);
-    for (size_t s = 0; s < ns; ++s) box[s] = segment_box(static_cast<int>(s), x, B);
-    std::vector<char> act(P.size(), 0);
-    std::vector<double> ex(P.size()), ec(P.size());
-    parallel_ranges(P.size(), P.size() >= kParallelMin ? thread_count() : 1, [&](size_t lo, size_t hi) {
-        for (size_t k = lo; k < hi; ++k) {
-            if (apart(box[P[k].a], box[P[k].b], B * P[k].image.cast<double>())) continue;
-            CapillaryPairParts parts;
-            capillary_pair_energy(list_.coordinates(P[k], x, B), m.segments[P[k].a].l0, m.segments[P[k].b].l0, wet_[k],
-                                  params_.pair, nullptr, nullptr, false, &parts);
-            act[k] = parts.nonzero, ex[k] = parts.crossing_energy, ec[k] = parts.contact_energy;
-        }
-    });
-    std::vector<int> on;
-    std::vector<double> Ex, Ec;
-    for (size_t k = 0; k < P.size(); ++k)
-        if (act[k]) on.push_back(static_cast<int>(k)), Ex.push_back(ex[k]), Ec.push_back(ec[k]);
-    pc = partner_cap(on, Ex, Ec);
-    return on;
 }
 
 SmoothWetEnergy::PartnerCap SmoothWetEnergy::partner_cap(const std::vector<int>& on, const std::vector<double>& Ex,
@@ -511,9 +482,8 @@ void SmoothWetEnergy::strain_derivatives(const Eigen::VectorXd& q, const Eigen::
     const Eigen::Matrix2d B = F_ * m.box.B0();
     ensure_list(x, B);
     const std::vector<SegmentPair>& P = list_.pairs();
-    const std::vector<int> on = nonzero_pairs(x, B);
     PartnerCap pc;
-    if (capped()) pc = partner_cap(x, B, on);
+    const std::vector<int> on = nonzero_pairs(x, B, capped() ? &pc : nullptr);
     const bool saturation = !pc.saturating.empty();
     // With saturating segments, also each pair's contact gradient and rate dC_ab/dt (the cap's kappa_a (dC_a/dt)^2
     // and kappa_a dC_a/dt grad C_a, bundle_saturation.hpp).
@@ -567,7 +537,8 @@ SmoothWetSplit SmoothWetEnergy::split(const Eigen::VectorXd& q) const {
         const Eigen::VectorXd x = dry_.positions(q, F_);
         const Eigen::Matrix2d B = F_ * dry_.model().box.B0();
         ensure_list(x, B);
-        const PartnerCap pc = partner_cap(x, B, nonzero_pairs(x, B));
+        PartnerCap pc;
+        nonzero_pairs(x, B, &pc);
         s.crossing = pc.crossing, s.contact = pc.contact;
         return s;
     }

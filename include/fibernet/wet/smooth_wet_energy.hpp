@@ -106,8 +106,6 @@ private:
     double eval(const Eigen::VectorXd& q, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd);
     bool active() const { return params_.pair.beta != 0; }
     bool wet_crossing(const SegmentPair& p) const;
-    // Indices of the listed pairs that are non-zero at x (in list order).
-    std::vector<int> nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
     // The pattern at x from the list in use: `on` its non-zero pairs there, n the partner counts (with the cap).
     void build_pattern(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on,
                        const std::vector<double>& n);
@@ -120,7 +118,7 @@ private:
     // f(pair, its local coordinates) for every non-zero pair at q, in list order.
     void for_each_nonzero(const Eigen::VectorXd& q,
                           const std::function<void(const SegmentPair&, const Vector8d&)>& f) const;
-    // The partner cap (bundle_saturation.hpp) at positions x over the non-zero pairs `on`.
+    // The partner cap (bundle_saturation.hpp) over the non-zero pairs `on` at some positions.
     struct PartnerCap {
         std::vector<double> scale;    // per entry of `on`: the pair's contact weight (S'(n_a) + S'(n_b)) / 2
         std::vector<char> touching;   // per entry of `on`: its contact term is non-zero
@@ -130,11 +128,11 @@ private:
         double crossing = 0, contact = 0;  // the crossing terms' energy and the capped contact energy
     };
     bool capped() const { return params_.bundle_partners > 0; }
-    PartnerCap partner_cap(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& on) const;
-    // The same from the non-zero pairs' crossing and contact energies (per entry of `on`).
+    // The partner cap from the non-zero pairs' crossing and contact energies Ex, Ec (per entry of `on`).
     PartnerCap partner_cap(const std::vector<int>& on, const std::vector<double>& Ex, const std::vector<double>& Ec) const;
-    // nonzero_pairs() with the partner cap over them (pc), each pair's values computed once.
-    std::vector<int> nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, PartnerCap& pc) const;
+    // Indices of the listed pairs that are non-zero at x (in list order); pc (if given) gets the partner cap over them,
+    // each pair's values computed once.
+    std::vector<int> nonzero_pairs(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, PartnerCap* pc = nullptr) const;
     // Per saturating segment: the entries of `on` whose pair holds it and has a contact term.
     std::vector<std::vector<int>> saturating_pairs(const PartnerCap& pc, const std::vector<int>& on) const;
     // Adds the cap's coupling of each saturating segment's partners, kappa_a G_a G_a^T with G_a the gradient of its
