@@ -12,8 +12,8 @@ namespace fibernet {
 template <int N>
 struct Jet {
     // The Hessian is symmetric: only its lower triangle is carried, packed column by column (column j holds rows
-    // j..N-1 from offset off(j)), which is 21 numbers instead of 36 for N = 6 and cuts the pair term's jets by a third
-    // or more (docs/benchmarks.md). hessian() unpacks it.
+    // j..N-1 from offset off(j)), N (N + 1) / 2 numbers instead of N^2 in every operation (docs/benchmarks.md, "The
+    // pair term's jets"). hessian() unpacks it.
     static constexpr int P = N * (N + 1) / 2;
     using Gradient = Eigen::Matrix<double, N, 1>;
     using Packed = Eigen::Matrix<double, P, 1>;
