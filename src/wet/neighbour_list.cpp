@@ -206,6 +206,22 @@ struct NeighbourList::Cache {
     Frame fr;
     Grid grid;
     std::vector<SegInfo> seg;
+    // update()'s work arrays, per segment, kept so that an update costs the segments it moves, not the network: whether
+    // a segment is one of those moved (in, cleared after), the pass that last met it next to a moved segment and at
+    // which image (seen, seen_image: each (b, image) is tested once per moved segment, not once per cell they share),
+    // and its ends and reach at the update's positions (info, valid when info_pass is the update's pass).
+    struct Scratch {
+        std::vector<char> in;
+        std::vector<long> seen, info_pass;
+        std::vector<Eigen::Vector2i> seen_image;
+        std::vector<SegInfo> info;
+        long pass = 0;
+        void size(size_t ns) {
+            if (in.size() == ns) return;
+            in.assign(ns, 0), seen.assign(ns, -1), info_pass.assign(ns, -1);
+            seen_image.assign(ns, Eigen::Vector2i::Zero()), info.assign(ns, SegInfo{});
+        }
+    } scratch;
 };
 
 namespace {
@@ -238,7 +254,7 @@ void NeighbourList::build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, do
     for (const auto& f : found) pairs_.insert(pairs_.end(), f.begin(), f.end());
     x_built_ = x;
     B_built_ = B;
-    cache_ = std::make_shared<Cache>(Cache{fr, std::move(grid), std::move(seg)});
+    cache_ = std::make_shared<Cache>(Cache{fr, std::move(grid), std::move(seg), {}});
     origin_.clear();
     origin_build_ = -1;
     ++builds_;
@@ -261,8 +277,11 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
             const SegInfo g = segment_info(m_, a, x, B, range_, built_skin_);
             if (!cells_of(g, g.reach + grow, c.fr, c.grid, periodic, cells)) return build(x, B);
         }
-    std::vector<char> in(m_.segments.size(), 0);
+    Cache::Scratch& w = c.scratch;
+    w.size(m_.segments.size());
+    std::vector<char>& in = w.in;
     for (int a : segments) in[a] = 1;
+    const long update_pass = ++w.pass;  // info[b] is b's at x if info_pass[b] is this
     // The segments entered anew at x.
     for (int a : segments) {
         for (const Entry& e : c.grid.covers[a]) {
@@ -279,6 +298,7 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
     std::vector<SegmentPair> found;
     for (int a : segments) {
         const SegInfo& A = c.seg[a];
+        const long a_pass = ++w.pass;  // seen[b]: a's pass met b at seen_image[b] already
         cells_of(A, A.reach + grow, c.fr, c.grid, periodic, cells);
         for (const Entry& ca : cells)
             for (const Entry& eb : c.grid.cell[static_cast<size_t>(ca.k)]) {
@@ -289,9 +309,13 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
                 SegmentPair p;
                 if (a < b) p.a = a, p.b = b, p.image = image;
                 else p.a = b, p.b = a, p.image = -image;
+                if (w.seen[b] == a_pass && w.seen_image[b] == image) continue;  // met in another cell
+                w.seen[b] = a_pass, w.seen_image[b] = image;
                 if (touch(m_.segments[p.a], m_.segments[p.b], p.image)) continue;
                 // b where it is now, in the frame of its cells
-                SegInfo Bn = segment_info(m_, b, x, B, range_, built_skin_);
+                if (w.info_pass[b] != update_pass)
+                    w.info[b] = segment_info(m_, b, x, B, range_, built_skin_), w.info_pass[b] = update_pass;
+                const SegInfo& Bn = w.info[b];
                 const Eigen::Vector2d tt = c.fr.G * (rel - c.seg[b].wrap).cast<double>();
                 const double cut = std::max(A.reach, Bn.reach) + 0.5 * built_skin_ + extra;
                 if (segment_distance(A.p0, A.p1, Bn.p0 + tt, Bn.p1 + tt) >= cut) continue;
@@ -319,6 +343,7 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
     origin_.swap(origin);
     origin_build_ = builds_;
     for (int v : nodes) x_built_.segment<2>(2 * v) = x.segment<2>(2 * v);
+    for (int a : segments) in[a] = 0;
     ++builds_;
 }
 

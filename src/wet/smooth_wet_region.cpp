@@ -20,9 +20,12 @@ SmoothWetRegion::SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, co
     B_ = W.F_ * m.box.B0();
     W.ensure_list(x_, B_);  // valid at the held nodes from here on: they do not move
     xref_.resize(size());
+    local_x_.assign(x_.size(), -1);
+    seg_place_.assign(m.segments.size(), -1);
     for (int k = 0; k < size(); ++k) {
         const int xi = inc.dof_node[coords_[k]];
         coord_x_.push_back(xi);
+        local_x_[xi] = k;
         xref_[k] = m.x[xi];
         nodes_.push_back(xi / 2);
     }
@@ -102,31 +105,24 @@ void SmoothWetRegion::take_pairs() {
     for (int s : segs_) pairs_.insert(pairs_.end(), list.begin() + start[s], list.begin() + start[s + 1]);
     std::sort(pairs_.begin(), pairs_.end());
     pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
-    // Region index of coordinate c of node v, or -1 when it is held (or fixed).
-    auto local = [&](int v, int c) -> int {
-        const int d = W_.dry_.dof(v, c);
-        if (d < 0) return -1;
-        const auto it = std::lower_bound(coords_.begin(), coords_.end(), d);
-        return it != coords_.end() && *it == d ? static_cast<int>(it - coords_.begin()) : -1;
-    };
+    // Per pair the region index of its 8 coordinates, -1 where held (or fixed).
     idx_.assign(8 * pairs_.size(), -1);
     for (size_t i = 0; i < pairs_.size(); ++i) {
         int node[4];
         Eigen::Vector2i shift[4];
         W_.list_.nodes(P[pairs_[i]], node, shift);
-        for (int a = 0; a < 8; ++a) idx_[8 * i + a] = local(node[a / 2], a % 2);
+        for (int a = 0; a < 8; ++a) idx_[8 * i + a] = local_x_[2 * node[a / 2] + a % 2];
     }
     // The pairs' segments: the region's and their partners (the other segment of a moving pair).
+    for (int s : seg_) seg_place_[s] = -1;
     seg_ = segs_;
     for (int k : pairs_) seg_.push_back(P[k].a), seg_.push_back(P[k].b);
     std::sort(seg_.begin(), seg_.end());
     seg_.erase(std::unique(seg_.begin(), seg_.end()), seg_.end());
-    auto local_seg = [&](int s) {
-        return static_cast<int>(std::lower_bound(seg_.begin(), seg_.end(), s) - seg_.begin());
-    };
+    for (size_t j = 0; j < seg_.size(); ++j) seg_place_[seg_[j]] = static_cast<int>(j);
     pair_seg_.resize(2 * pairs_.size());
     for (size_t i = 0; i < pairs_.size(); ++i)
-        pair_seg_[2 * i] = local_seg(P[pairs_[i]].a), pair_seg_[2 * i + 1] = local_seg(P[pairs_[i]].b);
+        pair_seg_[2 * i] = seg_place_[P[pairs_[i]].a], pair_seg_[2 * i + 1] = seg_place_[P[pairs_[i]].b];
     list_build_ = W_.list_.builds();
     if (W_.capped()) take_cap_segments();
 }

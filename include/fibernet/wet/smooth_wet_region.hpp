@@ -74,6 +74,8 @@ private:
     // The region's segments and their partners (ascending), per pair its two segments' places there; the partner
     // cap's contact energy per such segment of its pairs with held segments (0 for the region's own).
     std::vector<int> seg_, pair_seg_;
+    std::vector<int> local_x_;    // per entry of x_: its region coordinate, -1 if held or fixed
+    std::vector<int> seg_place_;  // per segment of the model: its place in seg_, -1 if none
     std::vector<double> fixed_C_;
     mutable std::vector<SmoothWetEnergy::SegmentBox> box_;  // per entry of seg_, at x_ (candidates())
     int list_build_ = -1;
