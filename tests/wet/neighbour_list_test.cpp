@@ -4,6 +4,8 @@
 // complete under further moves within half the skin of where each node was last built.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <algorithm>
+#include <map>
 #include <set>
 #include <tuple>
 
@@ -20,7 +22,8 @@ constexpr double kRange = 0.8, kSkin = 0.5;
 
 // Pairs (a < b, image) of segments of different fibers sharing no node, within kRange at positions x in box B: every
 // image within two box lengths.
-std::set<std::tuple<int, int, int, int>> brute_force(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B) {
+std::set<std::tuple<int, int, int, int>> brute_force(const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+                                                     double range = kRange) {
     std::set<std::tuple<int, int, int, int>> out;
     const int ns = static_cast<int>(m.segments.size());
     for (int a = 0; a < ns; ++a)
@@ -33,18 +36,19 @@ std::set<std::tuple<int, int, int, int>> brute_force(const Model& m, const Eigen
                     const Eigen::Vector2i t(tx, ty);
                     const Eigen::Vector2d b0 = x.segment<2>(2 * sb.i) + B * t.cast<double>();
                     const Eigen::Vector2d b1 = x.segment<2>(2 * sb.j) + B * (t + sb.shift).cast<double>();
-                    if (segment_distance(a0, a1, b0, b1) < kRange) out.insert({a, b, tx, ty});
+                    if (segment_distance(a0, a1, b0, b1) < range) out.insert({a, b, tx, ty});
                 }
         }
     return out;
 }
 
 // The pairs within range that the list lacks.
-int missing(const NeighbourList& list, const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B) {
+int missing(const NeighbourList& list, const Model& m, const Eigen::VectorXd& x, const Eigen::Matrix2d& B,
+            double range = kRange) {
     std::set<std::tuple<int, int, int, int>> listed;
     for (const SegmentPair& p : list.pairs()) listed.insert({p.a, p.b, p.image.x(), p.image.y()});
     int n = 0;
-    for (const auto& p : brute_force(m, x, B)) n += !listed.count(p);
+    for (const auto& p : brute_force(m, x, B, range)) n += !listed.count(p);
     return n;
 }
 
@@ -186,4 +190,47 @@ TEST_CASE("neighbour list: update() lists the pairs that held nodes' drift and t
     REQUIRE(list.valid(xf, B));
     REQUIRE(!brute_force(m, xf, B).empty());
     CHECK(missing(list, m, xf, B) == 0);
+}
+
+TEST_CASE("neighbour list: update() with a range beyond half the box lists each pair at every image in range",
+          "[wet][neighbour_list]") {
+    // A range of 12 in a sheared box 21 units wide: a pair of segments lies within range at several images, the grid
+    // has a single cell, and update() meets each neighbour there at several wraps. It must test each (segment, image)
+    // on its own and list each once.
+    constexpr double kWide = 12;
+    const Model m = model_of(mikado(2.1, 2, 0.5, 11), 4);
+    Eigen::Matrix2d F;
+    F << 1.0, 0.3, 0.0, 1.0;
+    const Eigen::Matrix2d B = F * m.box.B0();
+    Eigen::VectorXd x(2 * m.num_nodes());
+    for (int v = 0; v < m.num_nodes(); ++v) x.segment<2>(2 * v) = F * m.x.segment<2>(2 * v);
+    NeighbourList list(m, [](double) { return kWide; }, kSkin);
+    list.build(x, B);
+    REQUIRE(missing(list, m, x, B, kWide) == 0);
+    // Pairs within range at two or more images: the case this test is about.
+    std::map<std::pair<int, int>, int> images;
+    for (const auto& p : brute_force(m, x, B, kWide)) ++images[{std::get<0>(p), std::get<1>(p)}];
+    int multi = 0;
+    for (const auto& ab_n : images) multi += ab_n.second > 1;
+    REQUIRE(multi > 5);
+    // The first fiber's nodes moved by 5 along x and 3 along y, then the list updated for their segments.
+    std::vector<char> in(m.num_nodes(), 0);
+    for (const Segment& s : m.segments)
+        if (s.fiber == 0) in[s.i] = in[s.j] = 1;
+    std::vector<int> nodes, segs;
+    for (int v = 0; v < m.num_nodes(); ++v)
+        if (in[v]) nodes.push_back(v);
+    for (int s = 0; s < static_cast<int>(m.segments.size()); ++s)
+        if (in[m.segments[s].i] || in[m.segments[s].j]) segs.push_back(s);
+    Eigen::VectorXd x2 = x;
+    for (int v : nodes) x2[2 * v] += 5.0, x2[2 * v + 1] += 3.0;
+    REQUIRE(missing(list, m, x2, B, kWide) > 0);
+    list.update(x2, B, segs, nodes);
+    CHECK(missing(list, m, x2, B, kWide) == 0);
+    const std::vector<SegmentPair>& P = list.pairs();
+    bool ordered = true;  // strictly: no pair twice
+    for (size_t k = 1; k < P.size(); ++k)
+        ordered = ordered && std::tie(P[k - 1].a, P[k - 1].b, P[k - 1].image.x(), P[k - 1].image.y()) <
+                                 std::tie(P[k].a, P[k].b, P[k].image.x(), P[k].image.y());
+    CHECK(ordered);
 }
