@@ -166,6 +166,7 @@ void NonlinearElimination::eliminate(
         // Newton accepts only steps that lower the energy, so its last state is never worse than the start, converged
         // or not; a non-finite start leaves qa as it was.
         for (size_t k = 0; k < part.size(); ++k) q[part[k]] = qa[k];
+        sub.reset();  // a restriction may hand what it changed back to f when it ends (SmoothWetRegion): before f is used
         if (between) between(q, counts_.local_solves - solves_before, static_cast<int>(parts().size()));
     }
     counts_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

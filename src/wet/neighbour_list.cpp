@@ -255,14 +255,16 @@ void NeighbourList::build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, do
     x_built_ = x;
     B_built_ = B;
     cache_ = std::make_shared<Cache>(Cache{fr, std::move(grid), std::move(seg), {}});
+    found_build_ = -1;
+    ++listings_;
     origin_.clear();
     origin_build_ = -1;
     ++builds_;
 }
 
-void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& segments,
-                           const std::vector<int>& nodes) {
-    if (!cache_ || builds_ == 0 || B != B_built_ || x.size() != x_built_.size()) return build(x, B);
+bool NeighbourList::find(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& segments,
+                         const std::vector<int>& nodes, std::vector<SegmentPair>& found) {
+    if (!cache_ || builds_ == 0 || B != B_built_ || x.size() != x_built_.size()) return build(x, B), false;
     if (cache_.use_count() > 1) cache_ = std::make_shared<Cache>(*cache_);  // copies of this list keep theirs
     Cache& c = *cache_;
     const bool periodic = m_.box.periodic;
@@ -275,7 +277,7 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
     if (!periodic)  // an open box's grid covers the segments as built, with a margin: a segment beyond it needs a build
         for (int a : segments) {
             const SegInfo g = segment_info(m_, a, x, B, range_, built_skin_);
-            if (!cells_of(g, g.reach + grow, c.fr, c.grid, periodic, cells)) return build(x, B);
+            if (!cells_of(g, g.reach + grow, c.fr, c.grid, periodic, cells)) return build(x, B), false;
         }
     Cache::Scratch& w = c.scratch;
     w.size(m_.segments.size());
@@ -295,7 +297,7 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
         cells_of(g, g.reach, c.fr, c.grid, periodic, c.grid.covers[a]);
         for (const Entry& e : c.grid.covers[a]) c.grid.cell[static_cast<size_t>(e.k)].push_back({a, e.t});
     }
-    std::vector<SegmentPair> found;
+    found.clear();
     for (int a : segments) {
         const SegInfo& A = c.seg[a];
         const long a_pass = ++w.pass;  // seen[b]: a's pass met b at seen_image[b] already
@@ -324,6 +326,18 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
     }
     std::sort(found.begin(), found.end(), pair_less);
     found.erase(std::unique(found.begin(), found.end(), pair_equal), found.end());
+    for (int a : segments) in[a] = 0;
+    for (int v : nodes) x_built_.segment<2>(2 * v) = x.segment<2>(2 * v);
+    found_build_ = builds_;
+    ++listings_;
+    return true;
+}
+
+void NeighbourList::replace(const std::vector<int>& segments, const std::vector<SegmentPair>& found) {
+    if (found_build_ != builds_) throw std::logic_error("NeighbourList::replace: the list changed since find()");
+    found_build_ = -1;
+    std::vector<char>& in = cache_->scratch.in;
+    for (int a : segments) in[a] = 1;
     // The kept pairs (no segment of `segments`) and the found ones, merged in list order; each pair remembers its
     // index before the update (origin(), -1 if found), so that callers re-index only the found ones. The two sets are
     // disjoint, so the order is std::merge's.
@@ -342,13 +356,19 @@ void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, c
     pairs_.swap(merged);
     origin_.swap(origin);
     origin_build_ = builds_;
-    for (int v : nodes) x_built_.segment<2>(2 * v) = x.segment<2>(2 * v);
     for (int a : segments) in[a] = 0;
     ++builds_;
 }
 
+void NeighbourList::update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& segments,
+                           const std::vector<int>& nodes) {
+    std::vector<SegmentPair> found;
+    if (find(x, B, segments, nodes, found)) replace(segments, found);
+}
+
 bool NeighbourList::valid(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const {
     if (builds_ == 0 || B != B_built_ || x.size() != x_built_.size()) return false;
+    if (pending()) return false;  // a region's pairs found but not yet replaced: the list is not whole
     const double h2 = 0.25 * built_skin_ * built_skin_;
     for (Eigen::Index k = 0; k + 1 < x.size(); k += 2) {
         const double dx = x[k] - x_built_[k], dy = x[k + 1] - x_built_[k + 1];

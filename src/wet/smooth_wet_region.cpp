@@ -40,13 +40,12 @@ SmoothWetRegion::SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, co
     // that is non-zero or closer than the pattern distance here, and with the cap the blocks between the aligned such
     // pairs of each segment near the saturation blend (within 1/2 of it). A pair that becomes non-zero outside them
     // later leaves its block out (pattern_stale()).
-    const std::vector<SegmentPair>& P = W_.list_.pairs();
     const CapillaryPairParams& pp = W_.params_.pair;
     const double reach = std::sin((pp.angle_hi_deg + 15) * M_PI / 180);
     std::vector<int> el, sat, near;  // near: indices into pairs_
     for (size_t i = 0; i < pairs_.size(); ++i) {
-        const Vector8d X = W_.list_.coordinates(P[pairs_[i]], x_, B_);
-        const bool on = !W_.beyond_support(X) && !capillary_pair_vanishes(X, W_.wet_[pairs_[i]], pp);
+        const Vector8d X = W_.list_.coordinates(pairs_[i], x_, B_);
+        const bool on = !W_.beyond_support(X) && !capillary_pair_vanishes(X, wet_[i], pp);
         if (!on && segment_distance(X.segment<2>(0), X.segment<2>(2), X.segment<2>(4), X.segment<2>(6)) >=
                        W_.params_.pattern_distance)
             continue;
@@ -59,7 +58,7 @@ SmoothWetRegion::SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, co
         const double N = W_.params_.bundle_partners, h = kSaturationHalfWidth + 0.5;
         std::vector<std::pair<int, int>> of_segment;  // (segment's place in seg_, index into pairs_)
         for (int i : near) {
-            const Vector8d X = W_.list_.coordinates(P[pairs_[i]], x_, B_);
+            const Vector8d X = W_.list_.coordinates(pairs_[i], x_, B_);
             const Eigen::Vector2d d1 = X.segment<2>(2) - X.segment<2>(0), d2 = X.segment<2>(6) - X.segment<2>(4);
             const double cr = d1.x() * d2.y() - d1.y() * d2.x();
             if (cr * cr > reach * reach * d1.squaredNorm() * d2.squaredNorm()) continue;
@@ -95,35 +94,50 @@ void SmoothWetRegion::slot_pairs() {
     element_slots(pattern_, idx_, 8, slots_, &unpatterned_);
 }
 
+SmoothWetRegion::~SmoothWetRegion() {
+    // Pairs found by the region's own list updates go into W's list once, now (NeighbourList::find).
+    if (!own_pairs_ || !W_.list_.pending()) return;  // nothing found, or W's list was rebuilt since
+    ScopedSeconds timed(W_.seconds_lists_);
+    W_.list_.replace(segs_, pairs_);
+    W_.index_list();
+}
+
 void SmoothWetRegion::take_pairs() {
     W_.index_segment_pairs();
     const std::vector<SegmentPair>& P = W_.list_.pairs();
     const std::vector<int>& start = W_.seg_pair_start_;
     const std::vector<int>& list = W_.seg_pair_;
-    // The moving pairs: those of the region's segments.
-    pairs_.clear();
-    for (int s : segs_) pairs_.insert(pairs_.end(), list.begin() + start[s], list.begin() + start[s + 1]);
-    std::sort(pairs_.begin(), pairs_.end());
-    pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
+    // The moving pairs: those of the region's segments, in list order.
+    std::vector<int> at;
+    for (int s : segs_) at.insert(at.end(), list.begin() + start[s], list.begin() + start[s + 1]);
+    std::sort(at.begin(), at.end());
+    at.erase(std::unique(at.begin(), at.end()), at.end());
+    pairs_.resize(at.size()), wet_.resize(at.size());
+    for (size_t i = 0; i < at.size(); ++i) pairs_[i] = P[at[i]], wet_[i] = W_.wet_[at[i]];
+    own_pairs_ = false;
+    list_build_ = W_.list_.builds();
+    index_pairs();
+}
+
+void SmoothWetRegion::index_pairs() {
     // Per pair the region index of its 8 coordinates, -1 where held (or fixed).
     idx_.assign(8 * pairs_.size(), -1);
     for (size_t i = 0; i < pairs_.size(); ++i) {
         int node[4];
         Eigen::Vector2i shift[4];
-        W_.list_.nodes(P[pairs_[i]], node, shift);
+        W_.list_.nodes(pairs_[i], node, shift);
         for (int a = 0; a < 8; ++a) idx_[8 * i + a] = local_x_[2 * node[a / 2] + a % 2];
     }
     // The pairs' segments: the region's and their partners (the other segment of a moving pair).
     for (int s : seg_) seg_place_[s] = -1;
     seg_ = segs_;
-    for (int k : pairs_) seg_.push_back(P[k].a), seg_.push_back(P[k].b);
+    for (const SegmentPair& p : pairs_) seg_.push_back(p.a), seg_.push_back(p.b);
     std::sort(seg_.begin(), seg_.end());
     seg_.erase(std::unique(seg_.begin(), seg_.end()), seg_.end());
     for (size_t j = 0; j < seg_.size(); ++j) seg_place_[seg_[j]] = static_cast<int>(j);
     pair_seg_.resize(2 * pairs_.size());
     for (size_t i = 0; i < pairs_.size(); ++i)
-        pair_seg_[2 * i] = seg_place_[P[pairs_[i]].a], pair_seg_[2 * i + 1] = seg_place_[P[pairs_[i]].b];
-    list_build_ = W_.list_.builds();
+        pair_seg_[2 * i] = seg_place_[pairs_[i].a], pair_seg_[2 * i + 1] = seg_place_[pairs_[i].b];
     if (W_.capped()) take_cap_segments();
 }
 
@@ -153,12 +167,11 @@ void SmoothWetRegion::take_cap_segments() {
 }
 
 std::vector<int> SmoothWetRegion::candidates() const {
-    const std::vector<SegmentPair>& P = W_.list_.pairs();
     box_.resize(seg_.size());
     for (size_t j = 0; j < seg_.size(); ++j) box_[j] = W_.segment_box(seg_[j], x_, B_);
     std::vector<int> out;
     for (size_t i = 0; i < pairs_.size(); ++i)
-        if (!W_.apart(box_[pair_seg_[2 * i]], box_[pair_seg_[2 * i + 1]], B_ * P[pairs_[i]].image.cast<double>()))
+        if (!W_.apart(box_[pair_seg_[2 * i]], box_[pair_seg_[2 * i + 1]], B_ * pairs_[i].image.cast<double>()))
             out.push_back(static_cast<int>(i));
     return out;
 }
@@ -169,7 +182,6 @@ SmoothWetRegion::CapState SmoothWetRegion::cap_state(const std::vector<int>& can
     // energy less a constant that does not depend on which pairs were taken: the crossing terms of the moving pairs,
     // -(beta / 2) l_a S(n_a) of the region's segments, and -(beta / 2) l_b [S(n_b) - S(n_b fixed)] of a partner b,
     // n_b fixed from its pairs with held segments alone (b's term less its value with the region's pairs at zero).
-    const std::vector<SegmentPair>& P = W_.list_.pairs();
     const Model& m = W_.dry_.model();
     const CapillaryPairParams& pp = W_.params_.pair;
     const double beta = pp.beta;
@@ -179,10 +191,10 @@ SmoothWetRegion::CapState SmoothWetRegion::cap_state(const std::vector<int>& can
     on.clear();
     if (contact) contact->clear();
     for (const int i : cand) {
-        const SegmentPair& pr = P[pairs_[i]];
+        const SegmentPair& pr = pairs_[i];
         CapillaryPairParts parts;
-        capillary_pair_energy(W_.list_.coordinates(pr, x_, B_), m.segments[pr.a].l0, m.segments[pr.b].l0,
-                              W_.wet_[pairs_[i]], pp, nullptr, nullptr, false, &parts);
+        capillary_pair_energy(W_.list_.coordinates(pr, x_, B_), m.segments[pr.a].l0, m.segments[pr.b].l0, wet_[i], pp,
+                              nullptr, nullptr, false, &parts);
         if (!parts.nonzero) continue;
         on.push_back(i);
         crossing += parts.crossing_energy;
@@ -212,10 +224,18 @@ void SmoothWetRegion::place(const Eigen::VectorXd& qa) {
 
 double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) {
     place(qa);
-    if (!W_.list_.valid_at(nodes_, x_, B_)) {  // the region left the list: W's list anew for its segments
+    if (!W_.list_.valid_at(nodes_, x_, B_)) {  // the region left the list: its pairs anew (W's list gets them at the end)
         ScopedSeconds timed(W_.seconds_lists_);
-        W_.list_.update(x_, B_, segs_, nodes_);
-        W_.index_list();
+        if (W_.list_.find(x_, B_, segs_, nodes_, pairs_)) {
+            wet_.resize(pairs_.size());
+            for (size_t i = 0; i < pairs_.size(); ++i) wet_[i] = static_cast<char>(W_.wet_crossing(pairs_[i]));
+            own_pairs_ = true;
+            list_build_ = W_.list_.builds();  // they are the pairs of W's list as it stands, with this region's anew
+            index_pairs(), slot_pairs();
+        } else {  // a full build instead: W's list is whole again
+            own_pairs_ = false;
+            W_.index_list();
+        }
     }
     if (list_build_ != W_.list_.builds()) take_pairs(), slot_pairs();
     double E = 0;
@@ -230,7 +250,6 @@ double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eige
         E = dry_.value(qa);
     }
     if (!W_.active()) return E;
-    const std::vector<SegmentPair>& P = W_.list_.pairs();
     const Model& m = W_.dry_.model();
     const CapillaryPairParams& pp = W_.params_.pair;
     // The non-zero pairs (indices into pairs_); with the cap, its state over them.
@@ -246,7 +265,7 @@ double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eige
         if (!g && !H) return E;
     } else {
         for (const int i : cand)
-            if (!capillary_pair_vanishes(W_.list_.coordinates(P[pairs_[i]], x_, B_), W_.wet_[pairs_[i]], pp))
+            if (!capillary_pair_vanishes(W_.list_.coordinates(pairs_[i], x_, B_), wet_[i], pp))
                 on.push_back(i);
     }
     bool saturation = false;
@@ -256,10 +275,10 @@ double SmoothWetRegion::eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eige
     Matrix8d he;
     for (size_t j = 0; j < on.size(); ++j) {
         const int i = on[j];
-        const SegmentPair& p = P[pairs_[i]];
+        const SegmentPair& p = pairs_[i];
         const double scale = capped ? 0.5 * (cs.dS[pair_seg_[2 * i]] + cs.dS[pair_seg_[2 * i + 1]]) : 1.0;
         const double e = capillary_pair_energy(W_.list_.coordinates(p, x_, B_), m.segments[p.a].l0, m.segments[p.b].l0,
-                                               W_.wet_[pairs_[i]], pp, g || H ? &ge : nullptr, H ? &he : nullptr, psd,
+                                               wet_[i], pp, g || H ? &ge : nullptr, H ? &he : nullptr, psd,
                                                nullptr, scale, saturation ? &cg[j] : nullptr);
         if (!capped) E += e;
         if (!g && !H) continue;

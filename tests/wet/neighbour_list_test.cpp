@@ -234,3 +234,59 @@ TEST_CASE("neighbour list: update() with a range beyond half the box lists each 
                                  std::tie(P[k].a, P[k].b, P[k].image.x(), P[k].image.y());
     CHECK(ordered);
 }
+
+TEST_CASE("neighbour list: find() then replace() is update(); the list is not valid in between", "[wet][neighbour_list]") {
+    const Model m = model_of(mikado(2.5, 6, 0.5, 5), 8);
+    const Eigen::Matrix2d B = m.box.B0();
+    const Eigen::VectorXd x = m.x;
+    // A region (the nodes within 6 of a node) moved by 4 along x.
+    const Eigen::Vector2d c = x.segment<2>(2 * (m.num_nodes() / 2));
+    std::vector<int> nodes, segs;
+    std::vector<char> in(m.num_nodes(), 0);
+    for (int v = 0; v < m.num_nodes(); ++v)
+        if ((x.segment<2>(2 * v) - c).norm() < 6) nodes.push_back(v), in[v] = 1;
+    for (int s = 0; s < static_cast<int>(m.segments.size()); ++s)
+        if (in[m.segments[s].i] || in[m.segments[s].j]) segs.push_back(s);
+    REQUIRE(nodes.size() > 10);
+    Eigen::VectorXd x2 = x;
+    for (int v : nodes) x2[2 * v] += 4.0;
+    auto same = [](const std::vector<SegmentPair>& p, const std::vector<SegmentPair>& q) {
+        bool eq = p.size() == q.size();
+        for (size_t k = 0; eq && k < p.size(); ++k) eq = p[k].a == q[k].a && p[k].b == q[k].b && p[k].image == q[k].image;
+        return eq;
+    };
+    NeighbourList split(m, [](double) { return kRange; }, kSkin), whole(m, [](double) { return kRange; }, kSkin);
+    split.build(x, B), whole.build(x, B);
+    const std::vector<SegmentPair> before = split.pairs();
+    const int builds = split.builds();
+    std::vector<SegmentPair> found;
+    REQUIRE(split.find(x2, B, segs, nodes, found));
+    // In between: the pairs as they were, the region's nodes recorded as built at x2, the whole list not valid.
+    CHECK(split.pending());
+    CHECK(same(split.pairs(), before));
+    CHECK(split.builds() == builds);
+    CHECK(split.valid_at(nodes, x2, B));
+    CHECK(!split.valid(x2, B));
+    split.replace(segs, found);
+    whole.update(x2, B, segs, nodes);
+    CHECK(!split.pending());
+    CHECK(split.valid(x2, B));
+    CHECK(same(split.pairs(), whole.pairs()));
+    CHECK(split.origin() == whole.origin());
+    CHECK(missing(split, m, x2, B) == 0);
+    // `found` is the region's share of the list: the pairs that hold one of its segments.
+    std::vector<char> is_seg(m.segments.size(), 0);
+    for (int s : segs) is_seg[s] = 1;
+    std::vector<SegmentPair> share;
+    for (const SegmentPair& p : whole.pairs())
+        if (is_seg[p.a] || is_seg[p.b]) share.push_back(p);
+    CHECK(same(found, share));
+    // A build voids a pending find, and replace() then refuses it.
+    Eigen::VectorXd x3 = x2;
+    for (int v : nodes) x3[2 * v + 1] += 4.0;
+    REQUIRE(split.find(x3, B, segs, nodes, found));
+    split.build(x3, B);
+    CHECK(!split.pending());
+    CHECK(split.valid(x3, B));
+    CHECK_THROWS_AS(split.replace(segs, found), std::logic_error);
+}

@@ -39,16 +39,31 @@ public:
     // a segment beyond an open box's grid: a full build at x.
     void update(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& segments,
                 const std::vector<int>& nodes);
+    // update() in two steps, so that a region's local solve can keep its pairs to itself while it moves and pay for the
+    // list's other pairs once, when it ends. find() lists the pairs that hold one of `segments` at x (`found`, in list
+    // order) and records `nodes` as built anew, but leaves pairs() as they were: until replace(), the list holds the
+    // pairs of every other segment, valid as before, and stale ones of `segments`. False (and `found` unused) when it
+    // made a full build at x instead (see update()). replace() then puts `found` in place of the pairs of `segments`
+    // (the same segments), with origin() as update() gives it; the list must not have changed since find().
+    bool find(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& segments,
+              const std::vector<int>& nodes, std::vector<SegmentPair>& found);
+    void replace(const std::vector<int>& segments, const std::vector<SegmentPair>& found);
+    // A find() awaits its replace(): valid() is false meanwhile (valid_at() is not), so that a whole-list user
+    // rebuilds instead of reading stale pairs; a build makes the pending find void.
+    bool pending() const { return found_build_ >= 0 && found_build_ == builds_; }
     // The largest displacement of a node from its position at the last build (infinity if none or B differs).
     double max_displacement(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
     const Eigen::VectorXd& built_at() const { return x_built_; }
     // Whether the list still holds every pair within `range` at x in the box B (built, same B, every node within
-    // skin / 2 of where it was at the build).
+    // skin / 2 of where it was at the build, no find() pending).
     bool valid(const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
     // valid() for a state that differs from one where the list is valid only at `nodes` (a region's local solve).
     bool valid_at(const std::vector<int>& nodes, const Eigen::VectorXd& x, const Eigen::Matrix2d& B) const;
     const std::vector<SegmentPair>& pairs() const { return pairs_; }
+    // Changes of pairs() (builds and replacements): what an index over the pairs is kept against.
     int builds() const { return builds_; }
+    // Searches for pairs: full builds, and find() for a region (update() is one).
+    int listings() const { return listings_; }
     // When the list was last changed by update(): the build it was updated from (builds() - 1), and per pair its index
     // in that build's list, or -1 for a pair found anew. After a full build: -1 and no origins.
     int origin_build() const { return origin_build_; }
@@ -68,7 +83,8 @@ private:
     std::vector<SegmentPair> pairs_;
     Eigen::VectorXd x_built_;
     Eigen::Matrix2d B_built_ = Eigen::Matrix2d::Zero();
-    int builds_ = 0;
+    int builds_ = 0, listings_ = 0;
+    int found_build_ = -1;  // builds_ at the last find(), -1 once replaced or rebuilt
     int origin_build_ = -1;
     std::vector<int> origin_;
     std::vector<SegmentPair> merged_;  // update()'s buffers (swapped with pairs_ and origin_), kept between updates

@@ -82,7 +82,7 @@ public:
     bool pattern_current() const { return pattern_list_ == list_.builds(); }
     // A Hessian since the last rebuild() met a non-zero pair outside the pattern.
     bool pattern_stale() const { return stale_; }
-    int list_builds() const { return list_.builds(); }
+    int list_builds() const { return list_.listings(); }
     int pattern_builds() const { return pattern_builds_; }
     // Seconds spent building and updating the list (with the list's indexes) and building patterns, so far (parts of
     // the evaluations' time).

@@ -12,9 +12,11 @@
 // over the moving pairs of a) gets pattern blocks between the moving pairs of each segment near the blend.
 //
 // The neighbour list is the energy's: valid while the set's nodes stay within half the skin of the list's build (the
-// held nodes do not move). An evaluation beyond that updates the energy's list for the region's segments
-// (NeighbourList::update; a rebuild never changes the energy) and takes the moving pairs anew; a Hessian that then meets a non-zero pair outside the region's
-// pattern (built with the first list) leaves that block out, as the whole energy does (pattern_stale()).
+// held nodes do not move). An evaluation beyond that finds the region's pairs anew (NeighbourList::find, at the cost of
+// the region; a rebuild never changes the energy) and keeps them; W's list gets them when the region is destroyed, so
+// that a local solve passes over the whole list once, not at every update, and W must not be evaluated while a region
+// that moved is alive. A Hessian that meets a non-zero pair outside the region's pattern (built with the first list)
+// leaves that block out, as the whole energy does (pattern_stale()).
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
@@ -32,6 +34,10 @@ class SmoothWetRegion : public EvaluatedObjective {
 public:
     // W's energy over the coordinates `coords` of q (sorted, distinct). Keeps a reference to W.
     SmoothWetRegion(SmoothWetEnergy& W, const NodeElements& inc, const Eigen::VectorXd& q, const std::vector<int>& coords);
+    // Puts the pairs the region found while it moved into W's list (one pass over the list per region, not per update).
+    ~SmoothWetRegion() override;
+    SmoothWetRegion(const SmoothWetRegion&) = delete;
+    SmoothWetRegion& operator=(const SmoothWetRegion&) = delete;
 
     int size() const override { return static_cast<int>(coords_.size()); }
     const Eigen::SparseMatrix<double>& hessian_pattern() const override { return pattern_; }
@@ -39,9 +45,11 @@ public:
 
 private:
     double eval(const Eigen::VectorXd& qa, Eigen::VectorXd* g, Eigen::SparseMatrix<double>* H, bool psd) override;
-    // The moving pairs from W's list as it is now and their segments, and with the cap the held pairs' contact
-    // energies (take_cap_segments).
+    // The moving pairs from W's list as it is now (take_pairs), or as the region found them (eval), then their
+    // coordinates' region indices and segments, and with the cap the held pairs' contact energies (index_pairs,
+    // take_cap_segments).
     void take_pairs();
+    void index_pairs();
     void take_cap_segments();
     void slot_pairs();  // slots_ and unpatterned_ for the pairs taken
     void place(const Eigen::VectorXd& qa);  // the region's coordinates into x_
@@ -65,9 +73,12 @@ private:
     Eigen::VectorXd xref_;               // per region coordinate: its node's reference coordinate
     Eigen::Matrix2d B_;
     NetworkRegion dry_;
-    // The moving pairs (indices into W's list, in list order) and the region index of their 8 local coordinates
-    // (-1: held).
-    std::vector<int> pairs_;
+    // The moving pairs (the pairs of W's list that hold a segment of the region, in list order), whether each is a wet
+    // crossing, and the region index of their 8 local coordinates (-1: held). Once the region has left W's list
+    // (own_pairs_), it finds them itself (NeighbourList::find) and W's list holds stale ones until the destructor.
+    std::vector<SegmentPair> pairs_;
+    std::vector<char> wet_;
+    bool own_pairs_ = false;
     std::vector<int> idx_;      // 8 per pair
     std::vector<int> slots_;    // 64 per pair: value slots of its block in pattern_ (-1: none)
     std::vector<char> unpatterned_;  // per pair: the pattern lacks part of its block
