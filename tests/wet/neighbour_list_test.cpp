@@ -62,6 +62,33 @@ Eigen::VectorXd jiggle(Eigen::VectorXd x, double r, std::uint64_t seed, const st
     return x;
 }
 
+// Node positions of m's reference state under the deformation F.
+Eigen::VectorXd deformed(const Model& m, const Eigen::Matrix2d& F) {
+    Eigen::VectorXd x(2 * m.num_nodes());
+    for (int v = 0; v < m.num_nodes(); ++v) x.segment<2>(2 * v) = F * m.x.segment<2>(2 * v);
+    return x;
+}
+
+// Whether the pairs are in the list's order (segment a, then b, then image) with none twice.
+bool strictly_ordered(const std::vector<SegmentPair>& P) {
+    bool ordered = true;
+    for (size_t k = 1; k < P.size(); ++k)
+        ordered = ordered && std::tie(P[k - 1].a, P[k - 1].b, P[k - 1].image.x(), P[k - 1].image.y()) <
+                                 std::tie(P[k].a, P[k].b, P[k].image.x(), P[k].image.y());
+    return ordered;
+}
+
+// A region: the nodes within `radius` of c at x, and the segments with a node among them.
+void region_of(const Model& m, const Eigen::VectorXd& x, const Eigen::Vector2d& c, double radius, std::vector<int>& nodes,
+               std::vector<int>& segs) {
+    std::vector<char> in(m.num_nodes(), 0);
+    nodes.clear(), segs.clear();
+    for (int v = 0; v < m.num_nodes(); ++v)
+        if ((x.segment<2>(2 * v) - c).norm() < radius) nodes.push_back(v), in[v] = 1;
+    for (int s = 0; s < static_cast<int>(m.segments.size()); ++s)
+        if (in[m.segments[s].i] || in[m.segments[s].j]) segs.push_back(s);
+}
+
 }  // namespace
 
 TEST_CASE("neighbour list: every pair within range, built and updated", "[wet][neighbour_list]") {
@@ -69,8 +96,7 @@ TEST_CASE("neighbour list: every pair within range, built and updated", "[wet][n
     Eigen::Matrix2d F;
     F << 1.02, 0.08, 0.0, 0.99;
     const Eigen::Matrix2d B = F * m.box.B0();
-    Eigen::VectorXd x(2 * m.num_nodes());
-    for (int v = 0; v < m.num_nodes(); ++v) x.segment<2>(2 * v) = F * m.x.segment<2>(2 * v);
+    const Eigen::VectorXd x = deformed(m, F);
     std::vector<int> all(m.num_nodes());
     for (int v = 0; v < m.num_nodes(); ++v) all[v] = v;
     NeighbourList list(m, [](double) { return kRange; }, kSkin);
@@ -84,13 +110,8 @@ TEST_CASE("neighbour list: every pair within range, built and updated", "[wet][n
 
     // A region (the nodes within 6 of a node) moved by 4 along x: invalid there; update() for its segments.
     const Eigen::Vector2d c = x1.segment<2>(2 * (m.num_nodes() / 2));
-    std::vector<int> nodes;
-    std::vector<char> in_region(m.num_nodes(), 0);
-    for (int v = 0; v < m.num_nodes(); ++v)
-        if ((x1.segment<2>(2 * v) - c).norm() < 6) nodes.push_back(v), in_region[v] = 1;
-    std::vector<int> segs;
-    for (int s = 0; s < static_cast<int>(m.segments.size()); ++s)
-        if (in_region[m.segments[s].i] || in_region[m.segments[s].j]) segs.push_back(s);
+    std::vector<int> nodes, segs;
+    region_of(m, x1, c, 6, nodes, segs);
     REQUIRE(nodes.size() > 10);
     Eigen::VectorXd x2 = x1;
     for (int v : nodes) x2[2 * v] += 4.0;
@@ -135,12 +156,7 @@ TEST_CASE("neighbour list: every pair within range, built and updated", "[wet][n
     }
     // A second region, overlapping the first, moved the other way: the same.
     std::vector<int> nodes2, segs2;
-    std::vector<char> in2(m.num_nodes(), 0);
-    const Eigen::Vector2d c2 = c + Eigen::Vector2d(4.0, 5.0);
-    for (int v = 0; v < m.num_nodes(); ++v)
-        if ((x2.segment<2>(2 * v) - c2).norm() < 5) nodes2.push_back(v), in2[v] = 1;
-    for (int s = 0; s < static_cast<int>(m.segments.size()); ++s)
-        if (in2[m.segments[s].i] || in2[m.segments[s].j]) segs2.push_back(s);
+    region_of(m, x2, c + Eigen::Vector2d(4.0, 5.0), 5, nodes2, segs2);
     REQUIRE(nodes2.size() > 10);
     Eigen::VectorXd x4 = x2;
     for (int v : nodes2) x4[2 * v + 1] -= 3.0;
@@ -152,12 +168,7 @@ TEST_CASE("neighbour list: every pair within range, built and updated", "[wet][n
         CHECK(missing(list, m, x5, B) == 0);
     }
     // The pairs stay in the list's order (segment a, then b, then image), as a build gives them.
-    const std::vector<SegmentPair>& P = list.pairs();
-    bool ordered = true;
-    for (size_t k = 1; k < P.size(); ++k)
-        ordered = ordered && std::tie(P[k - 1].a, P[k - 1].b, P[k - 1].image.x(), P[k - 1].image.y()) <
-                                 std::tie(P[k].a, P[k].b, P[k].image.x(), P[k].image.y());
-    CHECK(ordered);
+    CHECK(strictly_ordered(list.pairs()));
 }
 
 TEST_CASE("neighbour list: update() lists the pairs that held nodes' drift and the region's can bring into range",
@@ -202,8 +213,7 @@ TEST_CASE("neighbour list: update() with a range beyond half the box lists each 
     Eigen::Matrix2d F;
     F << 1.0, 0.3, 0.0, 1.0;
     const Eigen::Matrix2d B = F * m.box.B0();
-    Eigen::VectorXd x(2 * m.num_nodes());
-    for (int v = 0; v < m.num_nodes(); ++v) x.segment<2>(2 * v) = F * m.x.segment<2>(2 * v);
+    const Eigen::VectorXd x = deformed(m, F);
     NeighbourList list(m, [](double) { return kWide; }, kSkin);
     list.build(x, B);
     REQUIRE(missing(list, m, x, B, kWide) == 0);
@@ -227,12 +237,7 @@ TEST_CASE("neighbour list: update() with a range beyond half the box lists each 
     REQUIRE(missing(list, m, x2, B, kWide) > 0);
     list.update(x2, B, segs, nodes);
     CHECK(missing(list, m, x2, B, kWide) == 0);
-    const std::vector<SegmentPair>& P = list.pairs();
-    bool ordered = true;  // strictly: no pair twice
-    for (size_t k = 1; k < P.size(); ++k)
-        ordered = ordered && std::tie(P[k - 1].a, P[k - 1].b, P[k - 1].image.x(), P[k - 1].image.y()) <
-                                 std::tie(P[k].a, P[k].b, P[k].image.x(), P[k].image.y());
-    CHECK(ordered);
+    CHECK(strictly_ordered(list.pairs()));
 }
 
 TEST_CASE("neighbour list: find() then replace() is update(); the list is not valid in between", "[wet][neighbour_list]") {
@@ -240,13 +245,8 @@ TEST_CASE("neighbour list: find() then replace() is update(); the list is not va
     const Eigen::Matrix2d B = m.box.B0();
     const Eigen::VectorXd x = m.x;
     // A region (the nodes within 6 of a node) moved by 4 along x.
-    const Eigen::Vector2d c = x.segment<2>(2 * (m.num_nodes() / 2));
     std::vector<int> nodes, segs;
-    std::vector<char> in(m.num_nodes(), 0);
-    for (int v = 0; v < m.num_nodes(); ++v)
-        if ((x.segment<2>(2 * v) - c).norm() < 6) nodes.push_back(v), in[v] = 1;
-    for (int s = 0; s < static_cast<int>(m.segments.size()); ++s)
-        if (in[m.segments[s].i] || in[m.segments[s].j]) segs.push_back(s);
+    region_of(m, x, x.segment<2>(2 * (m.num_nodes() / 2)), 6, nodes, segs);
     REQUIRE(nodes.size() > 10);
     Eigen::VectorXd x2 = x;
     for (int v : nodes) x2[2 * v] += 4.0;
