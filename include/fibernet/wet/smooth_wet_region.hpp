@@ -14,8 +14,8 @@
 // The neighbour list is the energy's: valid while the set's nodes stay within half the skin of the list's build (the
 // held nodes do not move). An evaluation beyond that finds the region's pairs anew (NeighbourList::find, at the cost of
 // the region; a rebuild never changes the energy) and keeps them; W's list gets them when the region is destroyed, so
-// that a local solve passes over the whole list once, not at every update, and W must not be evaluated while a region
-// that moved is alive. A Hessian that meets a non-zero pair outside the region's pattern (built with the first list)
+// that a local solve passes over the whole list once, not at every update (W evaluated meanwhile finds its list not
+// valid and rebuilds it, NeighbourList::pending; the region's pairs are then void). A Hessian that meets a non-zero pair outside the region's pattern (built with the first list)
 // leaves that block out, as the whole energy does (pattern_stale()).
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
