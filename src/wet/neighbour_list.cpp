@@ -206,7 +206,7 @@ struct NeighbourList::Cache {
     Frame fr;
     Grid grid;
     std::vector<SegInfo> seg;
-    // update()'s work arrays, per segment, kept so that an update costs the segments it moves, not the network: whether
+    // find()'s work arrays, per segment, kept so that a search costs the segments it moves, not the network: whether
     // a segment is one of those moved (in, cleared after), the pass that last met it next to a moved segment and at
     // which image (seen, seen_image: each (b, image) is tested once per moved segment, not once per cell they share),
     // and its ends and reach at the update's positions (info, valid when info_pass is the update's pass).
@@ -308,11 +308,11 @@ bool NeighbourList::find(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, con
                 if (b == a || m_.segments[b].fiber == m_.segments[a].fiber || (in[b] && b < a)) continue;
                 const Eigen::Vector2i rel = ca.t - eb.t;
                 const Eigen::Vector2i image = rel - c.seg[b].wrap + A.wrap;  // b's first node next to a's
+                if (w.seen[b] == a_pass && w.seen_image[b] == image) continue;  // met in another cell
+                w.seen[b] = a_pass, w.seen_image[b] = image;
                 SegmentPair p;
                 if (a < b) p.a = a, p.b = b, p.image = image;
                 else p.a = b, p.b = a, p.image = -image;
-                if (w.seen[b] == a_pass && w.seen_image[b] == image) continue;  // met in another cell
-                w.seen[b] = a_pass, w.seen_image[b] = image;
                 if (touch(m_.segments[p.a], m_.segments[p.b], p.image)) continue;
                 // b where it is now, in the frame of its cells
                 if (w.info_pass[b] != update_pass)

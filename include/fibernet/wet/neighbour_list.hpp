@@ -87,7 +87,7 @@ private:
     int found_build_ = -1;  // builds_ at the last find(), -1 once replaced or rebuilt
     int origin_build_ = -1;
     std::vector<int> origin_;
-    std::vector<SegmentPair> merged_;  // update()'s buffers (swapped with pairs_ and origin_), kept between updates
+    std::vector<SegmentPair> merged_;  // replace()'s buffers (swapped with pairs_ and origin_), kept between calls
     std::vector<int> origin_next_;
     struct Cache;
     std::shared_ptr<Cache> cache_;  // the last full build's grid, for update()
