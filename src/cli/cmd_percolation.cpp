@@ -36,7 +36,7 @@
 namespace fibernet::cli {
 
 namespace {
-const char* kHeader = "pl,L,q,sample,seed,fibers,d,rigid_spanning,connected_spanning,seconds";
+const char* kPercolationHeader = "pl,L,q,sample,seed,fibers,d,rigid_spanning,connected_spanning,seconds";
 
 std::string fmt(double v) {
     char b[64];
@@ -105,7 +105,7 @@ std::vector<PercolationSample> read_rows(const std::string& path, double pl, std
     while (std::getline(is, line)) {
         ++lineno;
         if (lineno == 1) {
-            if (line != kHeader) throw InputError(path + ":1: not a percolation CSV (header '" + line + "')");
+            if (line != kPercolationHeader) throw InputError(path + ":1: not a percolation CSV (header '" + line + "')");
             continue;
         }
         PercolationSample s;
@@ -263,7 +263,7 @@ struct SampleCsv {
         if (!csv) throw InputError("command line: cannot open --out " + path + " for writing");
         if (new_file) {
             std::ifstream probe(path);
-            if (probe.peek() == std::ifstream::traits_type::eof()) csv << kHeader << '\n';
+            if (probe.peek() == std::ifstream::traits_type::eof()) csv << kPercolationHeader << '\n';
         }
         csv.flush();
     }

@@ -27,7 +27,7 @@ namespace fibernet::cli {
 namespace {
 extern "C" void on_signal(int) { stop_requested() = true; }
 
-const char* kHeader =
+const char* kSweepHeader =
     "step,gamma,sigma_xx,sigma_xy,sigma_yy,stress_path,dsdgamma,dsdgamma_affine,energy,stretch,bend,iterations,factorizations,"
     "retries,grad_max,seconds";
 constexpr size_t kColumns = 16;
@@ -222,7 +222,7 @@ std::vector<std::pair<int, double>> truncate_csv(const std::string& path, int ro
     auto fail = [&](const std::string& m) { throw InputError("--resume: '" + path + "': " + m); };
     std::string line, kept;
     std::vector<std::pair<int, double>> steps;
-    if (!std::getline(is, line) || line != kHeader)
+    if (!std::getline(is, line) || line != kSweepHeader)
         fail(line.find("stress_path,K,K_affine,") != std::string::npos
                  ? "line 1 is the header of an earlier fibernet's sweep (columns K, K_affine, since renamed dsdgamma, "
                    "dsdgamma_affine): start the sweep again"
@@ -326,7 +326,7 @@ void register_sweep(CLI::App& app) {
                                                 show(start.t) + "\n");
         } else {
             if (series.on()) series.open(-1, {});
-            write_file_atomic(*out, std::string(kHeader) + "\n");
+            write_file_atomic(*out, std::string(kSweepHeader) + "\n");
             write_csv_sidecar(*out, params, column_docs());
             std::remove(ckpt->c_str());  // a completed sweep's checkpoint must not outlive a new run that fails early
         }

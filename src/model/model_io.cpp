@@ -52,7 +52,7 @@ void write_model(std::ostream& os, const Model& m, const Eigen::VectorXd& uin, c
 
 namespace {
 // Entries reserved ahead of reading them: a file's count is believed only as far as its lines bear it out.
-constexpr long kReserveAtMost = 1 << 16;
+constexpr long kModelReserveAtMost = 1 << 16;
 struct Reader {
     std::istream& is;
     std::string source;
@@ -148,7 +148,7 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* u
     // Entries are appended as they are read: a corrupt count must not allocate that many.
     const long n = r.section("nodes");
     std::vector<double> x_ref, u_ref;
-    x_ref.reserve(2 * static_cast<size_t>(std::min(n, kReserveAtMost)));
+    x_ref.reserve(2 * static_cast<size_t>(std::min(n, kModelReserveAtMost)));
     u_ref.reserve(x_ref.capacity());
     m.fixed.clear();
     for (long i = 0; i < n; ++i) {
@@ -170,7 +170,7 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* u
     const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(u_ref.data(), static_cast<Eigen::Index>(u_ref.size()));
     const long ns = r.section("segments");
     m.segments.clear();
-    m.segments.reserve(static_cast<size_t>(std::min(ns, kReserveAtMost)));
+    m.segments.reserve(static_cast<size_t>(std::min(ns, kModelReserveAtMost)));
     for (long e = 0; e < ns; ++e) {
         Segment& s = m.segments.emplace_back();
         auto ss = r.next("segment");
@@ -187,7 +187,7 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* u
     }
     const long nh = r.section("hinges");
     m.hinges.clear();
-    m.hinges.reserve(static_cast<size_t>(std::min(nh, kReserveAtMost)));
+    m.hinges.reserve(static_cast<size_t>(std::min(nh, kModelReserveAtMost)));
     for (long e = 0; e < nh; ++e) {
         Hinge& h = m.hinges.emplace_back();
         auto ss = r.next("hinge");
@@ -208,7 +208,7 @@ Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* u
     }
     const long nsn = r.section("supernodes");
     m.supernodes.clear();
-    m.supernodes.reserve(static_cast<size_t>(std::min(nsn, kReserveAtMost)));
+    m.supernodes.reserve(static_cast<size_t>(std::min(nsn, kModelReserveAtMost)));
     for (long e = 0; e < nsn; ++e) {
         Supernode& s = m.supernodes.emplace_back();
         auto ss = r.next("supernode");

@@ -42,7 +42,7 @@ void write_network(std::ostream& os, const Network& net) {
 
 namespace {
 // Entries reserved ahead of reading them: a file's count is believed only as far as its lines bear it out.
-constexpr long kReserveAtMost = 1 << 16;
+constexpr long kNetworkReserveAtMost = 1 << 16;
 struct LineReader {
     std::istream& is;
     std::string source;
@@ -140,9 +140,9 @@ long read_fibers(LineReader& r, Network& net) {
     if (kw != "fibers") r.fail("expected 'fibers N', found '" + r.text + "'");
     const long nf = r.integer(ss, "fiber count", 0, 100000000);
     r.expect_end(ss);
-    // Entries are appended as they are read: a corrupt count must not allocate that many (kReserveAtMost).
+    // Entries are appended as they are read: a corrupt count must not allocate that many (kNetworkReserveAtMost).
     net.fibers.clear();
-    net.fibers.reserve(static_cast<size_t>(std::min(nf, kReserveAtMost)));
+    net.fibers.reserve(static_cast<size_t>(std::min(nf, kNetworkReserveAtMost)));
     for (long i = 0; i < nf; ++i) {
         auto ls = r.next("fiber " + std::to_string(i));
         Fiber& f = net.fibers.emplace_back();
@@ -165,11 +165,11 @@ void read_crossings(LineReader& r, Network& net, long nf) {
     const long nc = r.integer(cs, "crossing count", 0, 1000000000);
     r.expect_end(cs);
     net.crossings.clear();
-    net.crossings.reserve(static_cast<size_t>(std::min(nc, kReserveAtMost)));
+    net.crossings.reserve(static_cast<size_t>(std::min(nc, kNetworkReserveAtMost)));
     // Two straight fibers cross at most once per periodic image: a repeated line would count twice. Found by
     // sorting (fiber pair, image, line) keys after reading (a map node per crossing cost ~200 MB at 2.5e6).
     std::vector<std::pair<std::array<int, 4>, std::array<long, 2>>> keys;  // key, (crossing, line)
-    keys.reserve(static_cast<size_t>(std::min(nc, kReserveAtMost)));
+    keys.reserve(static_cast<size_t>(std::min(nc, kNetworkReserveAtMost)));
     for (long k = 0; k < nc; ++k) {
         auto ls = r.next("crossing " + std::to_string(k));
         Crossing& c = net.crossings.emplace_back();

@@ -50,7 +50,7 @@ SceneOption choice(const char* t, const char* k, const char* f, const char* d,
     return o;
 }
 
-std::string quoted(const std::string& s) {  // a TOML basic string
+std::string toml_quoted(const std::string& s) {  // a TOML basic string
     std::string q = "\"";
     for (char c : s) {
         if (c == '"' || c == '\\') q += '\\', q += c;
@@ -203,8 +203,8 @@ std::string SceneOption::literal(const Scene& cs) const {
         case OptionKind::Integer: return std::to_string(integer(s));
         case OptionKind::Seed: return std::to_string(seed(s));
         case OptionKind::Boolean: return boolean(s) ? "true" : "false";
-        case OptionKind::Text: return quoted(text(s));
-        case OptionKind::Choice: return quoted(get_choice(s));
+        case OptionKind::Text: return toml_quoted(text(s));
+        case OptionKind::Choice: return toml_quoted(get_choice(s));
     }
     return "";
 }

@@ -44,7 +44,7 @@ struct CholmodLDL::Impl {
 };
 
 namespace {
-cholmod_sparse view(const Eigen::SparseMatrix<double>& A) { return detail::cholmod_upper_view(A, "CholmodLDL"); }
+cholmod_sparse ldl_view(const Eigen::SparseMatrix<double>& A) { return detail::cholmod_upper_view(A, "CholmodLDL"); }
 
 cholmod_dense dense_view(Eigen::VectorXd& v) {
     cholmod_dense d{};
@@ -89,7 +89,7 @@ struct SubPattern {
 // order with independent parts (checked here, since the factorization's threads rely on it).
 bool order_for_two(const Eigen::SparseMatrix<double>& upper, cholmod_common& c, std::vector<int>& perm, int& a, int& b) {
     const int n = static_cast<int>(upper.rows());
-    cholmod_sparse A = view(upper);
+    cholmod_sparse A = ldl_view(upper);
     std::vector<int> part(n);
     if (cholmod_bisect(&A, nullptr, 0, 1, part.data(), &c) < 0 || c.status != CHOLMOD_OK) {
         c.status = CHOLMOD_OK;
@@ -150,7 +150,7 @@ void CholmodLDL::analyze(const Eigen::SparseMatrix<double>& upper) {
     if (n < m.split_min || !order_for_two(upper, m.c, m.perm, m.a, m.b)) {
         m.a = m.b = 0;
         // CHOLMOD's choice of fill-reducing order (its default methods, then the postorder of the elimination tree).
-        cholmod_sparse A = view(upper);
+        cholmod_sparse A = ldl_view(upper);
         cholmod_factor* L0 = cholmod_analyze(&A, &m.c);
         if (!L0) throw std::runtime_error("CHOLMOD symbolic analysis failed (status " + std::to_string(m.c.status) + ")");
         m.perm.assign(static_cast<const int*>(L0->Perm), static_cast<const int*>(L0->Perm) + n);

@@ -33,7 +33,7 @@ struct CholmodLLT::Impl {
 };
 
 namespace {
-cholmod_sparse view(const Eigen::SparseMatrix<double>& A) { return detail::cholmod_upper_view(A, "CholmodLLT"); }
+cholmod_sparse llt_view(const Eigen::SparseMatrix<double>& A) { return detail::cholmod_upper_view(A, "CholmodLLT"); }
 }  // namespace
 
 CholmodLLT::CholmodLLT() : impl_(std::make_unique<Impl>()) {}
@@ -48,7 +48,7 @@ void CholmodLLT::forget() {
 
 void CholmodLLT::analyze(const Eigen::SparseMatrix<double>& upper) {
     if (impl_->L) cholmod_free_factor(&impl_->L, &impl_->c);
-    cholmod_sparse A = view(upper);
+    cholmod_sparse A = llt_view(upper);
     const InlineOpenMP on_this_thread;
     impl_->L = cholmod_analyze(&A, &impl_->c);
     if (!impl_->L) throw std::runtime_error("CHOLMOD symbolic analysis failed (status " + std::to_string(impl_->c.status) + ")");
@@ -62,7 +62,7 @@ bool CholmodLLT::factorize(const Eigen::SparseMatrix<double>& upper, double shif
     // A matrix of another size or fill than the analyzed one gets its own analysis (a caller reusing a wrapper
     // across models); same size and fill is taken as the same pattern.
     if (!impl_->L || upper.rows() != impl_->n || static_cast<long>(upper.nonZeros()) != impl_->nnz) analyze(upper);
-    cholmod_sparse A = view(upper);
+    cholmod_sparse A = llt_view(upper);
     double beta[2] = {shift, 0.0};
     impl_->c.status = CHOLMOD_OK;
     const InlineOpenMP on_this_thread;  // its supernodal memory passes (inline_openmp.hpp)

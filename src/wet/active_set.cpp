@@ -21,6 +21,7 @@
 #include "fibernet/util/parallel.hpp"
 #include "fibernet/wet/wet_region.hpp"
 #include "fibernet/wet/wetting.hpp"
+#include "fibernet/util/stopwatch.hpp"
 
 namespace fibernet {
 
@@ -29,9 +30,6 @@ std::string format_g(double g) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.2e", g);
     return buf;
-}
-double now() {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
@@ -622,7 +620,7 @@ private:
         r_.rounds = round;
         // The energy of this round's set: the one the last round's gradient was taken with, if there was one.
         std::unique_ptr<WetEnergy> Wp = next_ ? std::move(next_) : std::make_unique<WetEnergy>(dry_, F_, bridges_, params_);
-        double t0 = now();
+        double t0 = wall_seconds();
         so_.max_iter = capped_ ? opt_.round_iterations : budget_;
         so_.warm_start = (resume_ && opt_.warm_start) || restore_.saved.warm_start;  // Newton: keep its adapted shift
         so_.ldl = (opt_.newton_ldl && params_.beta > 0) || restore_.saved.ldl;      // beta = 0: the dry solve, bit for bit
@@ -635,12 +633,12 @@ private:
             ++r_.local_rounds;
             r_.local_iterations += r_.last.iterations;
             r_.timings_local += r_.last.timings;
-            r_.seconds_local += now() - t0;
+            r_.seconds_local += wall_seconds() - t0;
         } else {
             r_.last = solver_.minimize(*Wp, q_);
             ++global_rounds_;
         }
-        r_.seconds_solve += now() - t0;
+        r_.seconds_solve += wall_seconds() - t0;
         r_.solver_iterations += r_.last.iterations;
         r_.factorizations += r_.last.factorizations;
         r_.timings += r_.last.timings;
@@ -655,12 +653,12 @@ private:
             return false;
         }
         const bool failed_local = local && !r_.last.converged() && !limit;
-        t0 = now();
+        t0 = wall_seconds();
         const WetEvents ev = update_bridges(dry_, q_, F_, bridges_, opt_, &frozen_, r_.last.converged(),
                                             local ? &moved_nodes : nullptr);
         r_.per_round.push_back(ev);
         Signature sig = signature(bridges_);
-        r_.seconds_update += now() - t0;
+        r_.seconds_update += wall_seconds() - t0;
         r_.events.moves += ev.moves, r_.events.ruptures += ev.ruptures;
         r_.events.formed += ev.formed, r_.events.merged += ev.merged, r_.events.locked += ev.locked;
         r_.events.capped = ev.capped;  // a state count (the same candidates are refused every round), not a sum
@@ -668,7 +666,7 @@ private:
         bool equilibrium = false;
         if (r_.last.converged() || use_local_) equilibrium = settled(local, failed_local, moved_nodes, sig, gmax);
         else g_valid_ = false;
-        r_.seconds_events += now() - t0;
+        r_.seconds_events += wall_seconds() - t0;
         if (opt_.verbose) log_round(round, local, rc, gmax, ev);
         return decide(round, local, limit, equilibrium, std::move(sig));
     }
@@ -683,7 +681,7 @@ private:
         incidence_for(W, inc_);  // usually already W's: built after the last round, when the region was chosen
         RegionState state(W, q_);
         const auto parts = region_parts(W, inc_, region_);
-        r_.seconds_local_setup += now() - t0;
+        r_.seconds_local_setup += wall_seconds() - t0;
         so_.warm_start = restore_.saved.warm_start;  // each part adapts its own shift
         // The parts on FIBERNET_THREADS threads, largest first: they share no element and each writes only its own
         // nodes (of q and of the shared state), so no part's solve depends on another's. The last part (in the parts'
@@ -713,9 +711,9 @@ private:
             }
             for (size_t k = lo; k < hi; ++k) {
                 const size_t i = by_size[k];
-                const double ts = now();
+                const double ts = wall_seconds();
                 WetRegion R(W, state, parts[i], inc_);
-                setup[i] = now() - ts;
+                setup[i] = wall_seconds() - ts;
                 sizes[i] = R.size();
                 if (R.size() == 0) continue;
                 Eigen::VectorXd qa = R.restrict(q_);
@@ -761,7 +759,7 @@ private:
     // stable still means an equilibrium of every coordinate. Also chooses the next round's region (region_).
     bool settled(bool local, bool failed_local, const std::vector<char>& moved_nodes, const Signature& sig,
                  double& gmax) {
-        const double tg = now();
+        const double tg = wall_seconds();
         Signature changed;  // the bridges this round changed (both sets' entries)
         std::set_symmetric_difference(history_.last().begin(), history_.last().end(), sig.begin(), sig.end(),
                                       std::back_inserter(changed));
@@ -780,7 +778,7 @@ private:
         }
         g_valid_ = true;
         gmax = g_.size() ? g_.cwiseAbs().maxCoeff() : 0.0;
-        r_.seconds_gradient += now() - tg;
+        r_.seconds_gradient += wall_seconds() - tg;
         bool equilibrium = r_.last.converged() && gmax <= r_.last.grad_max * (1 + 1e-9);
         // A bridge formed without a torque at q (fibers crossing nearly parallel) leaves q an equilibrium but changes
         // the energy: the result's energy is the final set's.

@@ -10,14 +10,9 @@
 
 #include "box_search.hpp"
 #include "fibernet/wet/wet_energy.hpp"
+#include "fibernet/util/stopwatch.hpp"
 
 namespace fibernet {
-
-namespace {
-double now() {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-}  // namespace
 
 Stress wet_stress(const NetworkEnergy& dry, const Eigen::VectorXd& q, const Eigen::Matrix2d& F,
                   const std::vector<Bridge>& bridges, const WetParams& params) {
@@ -66,7 +61,7 @@ Eigen::Vector3d components(const Stress& s) {
 
 BoxSearch::BoxSearch(const NetworkEnergy& dry, const Eigen::Matrix2d& F0, double beta, const FreeBoxOptions& opt,
                      FreeBoxResult& R)
-    : dry_(dry), F0_(F0), opt_(opt), R_(R), n_(opt.isotropic ? 1 : 3), t0_(now()) {
+    : dry_(dry), F0_(F0), opt_(opt), R_(R), n_(opt.isotropic ? 1 : 3), t0_(wall_seconds()) {
     sc_ = free_box_stress_scale(dry.model(), F0, beta);
     // dE*/du_j = P : (dU_j F0) = A sigma : (dU_j U^-1) at an equilibrium (E* the relaxed energy).
     dU_.assign(n_, Eigen::Matrix2d::Zero());
@@ -74,7 +69,7 @@ BoxSearch::BoxSearch(const NetworkEnergy& dry, const Eigen::Matrix2d& F0, double
     else dU_[0](0, 0) = 1, dU_[1](1, 1) = 1, dU_[2](0, 1) = dU_[2](1, 0) = 1;
 }
 
-double BoxSearch::elapsed() const { return now() - t0_; }
+double BoxSearch::elapsed() const { return wall_seconds() - t0_; }
 
 Eigen::VectorXd BoxSearch::controlled(const Stress& s) const {
     const Eigen::Vector3d c = components(s) / sc_;

@@ -11,13 +11,11 @@
 
 #include "fibernet/util/error.hpp"
 #include "fibernet/wet/wet_moduli.hpp"
+#include "fibernet/util/stopwatch.hpp"
 
 namespace fibernet {
 
 namespace {
-double now() {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 // Faces narrower than the contact distance are walls, not pores, in either model (pores.hpp).
 double wall_width(const WetRunOptions& opt, const Model& m) {
     return opt.smooth.pair.contact > 0 ? opt.smooth.pair.contact : default_wall_width(m);
@@ -93,9 +91,9 @@ void smooth_run_free_box(WetRun& run, const NetworkEnergy& dry, const Eigen::Mat
     fb.pores = pores(m, xf, Bf, wall_width(opt, m));
     fb.bundles = bundles(m, xf, Bf, fb.bridges, opt.bundle_angle_deg);
     if (opt.moduli) {
-        const double t0 = now();
+        const double t0 = wall_seconds();
         smooth_linear_shear_modulus(dry, fb.F, fb.q, dry_pairs, sp, fb.shear_modulus, fb.shear_modulus_error);
-        run.seconds_moduli += now() - t0;
+        run.seconds_moduli += wall_seconds() - t0;
     }
 }
 
@@ -133,15 +131,15 @@ void run_wet_smooth(WetRun& run, const Network& net, const NetworkEnergy& dry, c
     const SmoothWetSplit split = W.split(run.wet.q);
     run.wet.energy.stretch = split.stretch, run.wet.energy.bend = split.bend;
     run.wet.energy.capillary = split.capillary();
-    double t0 = now();
+    double t0 = wall_seconds();
     const Eigen::VectorXd x = dry.positions(run.wet.q, F);
     run.wet.pores = pores(m, x, B, wall_width(opt, m));
     run.bundles = bundles(m, x, B, run.active.bridges, opt.bundle_angle_deg);
-    run.seconds_pores += now() - t0;
+    run.seconds_pores += wall_seconds() - t0;
     if (opt.moduli && run.wet.converged) {
-        t0 = now();
+        t0 = wall_seconds();
         smooth_shear_moduli(run.wet, dry, F, dry_pairs, sp, opt.smooth_relax, opt.modulus_strain, solver);
-        run.seconds_moduli += now() - t0;
+        run.seconds_moduli += wall_seconds() - t0;
     }
     if (opt.free_box.enabled) smooth_run_free_box(run, dry, F, dry_pairs, sp, opt, solver);
 }
@@ -213,7 +211,7 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     const Eigen::Matrix2d B = F * m.box.B0();
     auto solver = make_solver(opt.solver, opt.solver_options);
     const WetParams none;  // beta = 0: the dry energy
-    double t0 = now();
+    double t0 = wall_seconds();
     if (dry_start) {
         run.dry = *dry_start;
     } else {
@@ -222,14 +220,14 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
         run.dry_solve = solver->minimize(D, run.dry.q);
         run.dry.converged = run.dry_solve.converged();
         run.dry.energy = D.split(run.dry.q);
-        run.seconds_dry = now() - t0;
-        t0 = now();
+        run.seconds_dry = wall_seconds() - t0;
+        t0 = wall_seconds();
         run.dry.pores = pores(m, dry.positions(run.dry.q, F), B, wall_width(opt, m));
-        run.seconds_pores += now() - t0;
+        run.seconds_pores += wall_seconds() - t0;
         if (opt.moduli && run.dry.converged) {
-            t0 = now();
+            t0 = wall_seconds();
             shear_moduli(run.dry, dry, F, {}, none, *solver, opt.modulus_strain);
-            run.seconds_moduli += now() - t0;
+            run.seconds_moduli += wall_seconds() - t0;
         }
     }
     if (opt.model == WetModel::Smooth) {
@@ -255,15 +253,15 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
     run.seconds_events = run.active.seconds_events;
     run.wet.converged = run.active.last.converged();
     run.wet.energy = WetEnergy(dry, F, run.active.bridges, opt.params).split(run.wet.q);
-    t0 = now();
+    t0 = wall_seconds();
     const Eigen::VectorXd x = dry.positions(run.wet.q, F);
     run.wet.pores = pores(m, x, B, wall_width(opt, m));
     run.bundles = bundles(m, x, B, run.active.bridges, opt.bundle_angle_deg);
-    run.seconds_pores += now() - t0;
+    run.seconds_pores += wall_seconds() - t0;
     if (opt.moduli && run.wet.converged && run.active.stable) {  // the moduli of a consistent bridge set only
-        t0 = now();
+        t0 = wall_seconds();
         shear_moduli(run.wet, dry, F, run.active.bridges, opt.params, *solver, opt.modulus_strain);
-        run.seconds_moduli += now() - t0;
+        run.seconds_moduli += wall_seconds() - t0;
     }
     if (opt.free_box.enabled) {
         if (run.wet.converged && run.active.stable) {
@@ -274,10 +272,10 @@ WetRun run_wet(const Network& net, const Model& m, const Eigen::Matrix2d& F, con
             run.free_box.pores = pores(m, xf, Bf, wall_width(opt, m));
             run.free_box.bundles = bundles(m, xf, Bf, run.free_box.bridges, opt.bundle_angle_deg);
             if (opt.moduli) {
-                t0 = now();
+                t0 = wall_seconds();
                 linear_shear_modulus(dry, run.free_box.F, run.free_box.q, run.free_box.bridges, opt.params,
                                      run.free_box.shear_modulus, run.free_box.shear_modulus_error);
-                run.seconds_moduli += now() - t0;
+                run.seconds_moduli += wall_seconds() - t0;
             }
         } else {
             run.free_box.F0 = run.free_box.F = F;

@@ -1,9 +1,14 @@
 #pragma once
-// Adds the wall time of a scope to a running total (the smooth wet energy's list and pattern builds, reported in the
-// time split of a wet run).
+// Wall-clock seconds: a scope's added to a running total (the smooth wet energy's list and pattern builds, reported in
+// the time split of a wet run), and a steady clock's reading for differences.
 #include <chrono>
 
 namespace fibernet {
+
+// Seconds on the steady clock since its epoch: only differences mean anything.
+inline double wall_seconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 class ScopedSeconds {
 public:
