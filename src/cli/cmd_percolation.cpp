@@ -105,7 +105,8 @@ std::vector<PercolationSample> read_rows(const std::string& path, double pl, std
     while (std::getline(is, line)) {
         ++lineno;
         if (lineno == 1) {
-            if (line != kPercolationHeader) throw InputError(path + ":1: not a percolation CSV (header '" + line + "')");
+            if (line != kPercolationHeader)
+                throw InputError(path + ":1: not a percolation CSV (header '" + line + "')");
             continue;
         }
         PercolationSample s;
