@@ -19,9 +19,9 @@
 
 #include "fibernet/util/hash.hpp"
 #include "fibernet/util/parallel.hpp"
+#include "fibernet/util/stopwatch.hpp"
 #include "fibernet/wet/wet_region.hpp"
 #include "fibernet/wet/wetting.hpp"
-#include "fibernet/util/stopwatch.hpp"
 
 namespace fibernet {
 

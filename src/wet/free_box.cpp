@@ -9,8 +9,8 @@
 #include <sstream>
 
 #include "box_search.hpp"
-#include "fibernet/wet/wet_energy.hpp"
 #include "fibernet/util/stopwatch.hpp"
+#include "fibernet/wet/wet_energy.hpp"
 
 namespace fibernet {
 

@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "fibernet/util/error.hpp"
-#include "fibernet/wet/wet_moduli.hpp"
 #include "fibernet/util/stopwatch.hpp"
+#include "fibernet/wet/wet_moduli.hpp"
 
 namespace fibernet {
 
