@@ -331,10 +331,6 @@ int& exit_code() {
     return code;
 }
 
-double seconds_since(const std::chrono::steady_clock::time_point& t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 nlohmann::json prune_rules(const Scene& s) {
     nlohmann::json j = nlohmann::json::array();
     if (s.prune.dangling) j.push_back("dangling");

@@ -18,6 +18,7 @@
 #include "fibernet/scene/scene.hpp"
 #include "fibernet/solve/result.hpp"
 #include "fibernet/solve/solver.hpp"
+#include "fibernet/util/stopwatch.hpp"
 
 namespace fibernet::cli {
 
@@ -98,8 +99,6 @@ void flush_stdout();
 // The bytes of a file a result depends on (a network file, a law table), e.g. for its fingerprint (util/hash.hpp);
 // InputError naming `what` and the path if it cannot be read.
 std::string file_bytes(const std::string& path, const std::string& what);
-
-double seconds_since(const std::chrono::steady_clock::time_point& t0);
 
 // A progress line of a long command (sweep steps, wet betas): to stderr, or to the sink when one is set (the Python
 // package's progress callback).

@@ -13,15 +13,13 @@
 #include "fibernet/network/network_io.hpp"
 #include "fibernet/util/error.hpp"
 #include "fibernet/util/hash.hpp"
+#include "fibernet/util/stopwatch.hpp"
 
 namespace fibernet::cli {
 
 namespace {
 namespace fs = std::filesystem;
 
-double since(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 std::string matrix_text(const Eigen::Matrix2d& M) {
     char b[160];
@@ -116,12 +114,12 @@ void WetCheckpoints::begin(size_t k, double beta) {
 
 void WetCheckpoints::observe(const Eigen::VectorXd& q, double energy, double grad_max) {
     ++iterations_;
-    if (!enabled() || since(last_) < every_) return;
+    if (!enabled() || seconds_since(last_) < every_) return;
     write(q, energy, grad_max, false);
 }
 
 void WetCheckpoints::observe_within(const Eigen::VectorXd& q, const std::function<double()>& energy) {
-    if (!enabled() || since(last_) < every_) return;
+    if (!enabled() || seconds_since(last_) < every_) return;
     write(q, energy(), std::nullopt, false);
 }
 
@@ -164,7 +162,7 @@ bool WetCheckpoints::kept(const std::string& file) const {
 void WetCheckpoints::write(const Eigen::VectorXd& q, double energy, std::optional<double> grad_max, bool last) {
     const std::string stem = "checkpoint_" + std::to_string(k_);
     const bool within = !grad_max;
-    const double seconds = since(t0_);
+    const double seconds = seconds_since(t0_);
     const long before_it = start_ ? start_->iterations_before : 0;
     const double before_s = start_ ? start_->seconds_before : 0;
     std::ostringstream state;

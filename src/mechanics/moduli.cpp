@@ -11,12 +11,12 @@
 #include "fibernet/mechanics/equilibrium.hpp"
 #include "fibernet/solve/cholmod_llt.hpp"
 #include "fibernet/solve/newton.hpp"  // roundoff_floor
+#include "fibernet/util/stopwatch.hpp"
 
 namespace fibernet {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 }  // namespace
 
 StrainMode shear_mode(const Eigen::Matrix2d& F, double area) {
@@ -64,7 +64,7 @@ bool relaxed_at(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::M
         E_tt_size[m] = ev.d2E_dt2_size;
         b[m] = ev.d2E_dqdt;
     }
-    const double seconds_assembly = since(t0);
+    const double seconds_assembly = seconds_since(t0);
     // The formula holds at an equilibrium only (E_xt in range(H)); elsewhere it returns a plausible number with a
     // bound that says nothing (Newton stopped 4 iterations early on problems/default.toml at gamma = 0.01 gave G 1.4 %
     // off with a bound of 3e-10). Accepted: max|g| within equilibrium_tol or the coordinates' round-off floor, where
@@ -82,7 +82,7 @@ bool relaxed_at(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::M
         inf.message = buf;
         inf.grad_max = gmax, inf.grad_floor = floor;
         inf.seconds_assembly = seconds_assembly;
-        inf.seconds_total = since(t_start);
+        inf.seconds_total = seconds_since(t_start);
         return false;
     }
     // The relaxed part, in comoving coordinates (relaxed_moduli).
@@ -95,7 +95,7 @@ bool relaxed_at(const NetworkEnergy& e, const Eigen::VectorXd& q, const Eigen::M
     out = std::move(relaxed);
     inf.seconds_assembly += seconds_assembly;
     inf.grad_max = gmax, inf.grad_floor = floor;
-    inf.seconds_total = since(t_start);
+    inf.seconds_total = seconds_since(t_start);
     return true;
 }
 
@@ -159,11 +159,11 @@ std::vector<Modulus> linear_moduli(const NetworkEnergy& e, const Eigen::VectorXd
     if (!relaxed_at(e, q, F, modes, opt, inf, llt, g, out)) return out;
     auto t0 = Clock::now();
     affine_predictions(e, q, F, modes, out);
-    inf.seconds_affine = since(t0);
+    inf.seconds_affine = seconds_since(t0);
     bool all_ok = true;
     for (const auto& M : out) all_ok = all_ok && M.ok;
     if (opt.state_error && all_ok && e.num_dofs() > 0) state_error(e, q, F, modes, opt, g, llt, out, inf);
-    inf.seconds_total = since(t_start);
+    inf.seconds_total = seconds_since(t_start);
     return out;
 }
 
@@ -379,7 +379,7 @@ bool factor_shifted(LinearSolver& llt, const Eigen::SparseMatrix<double>& H, con
                     Eigen::SparseMatrix<double>& Hd, ModuliInfo& inf) {
     auto t0 = Clock::now();
     if (!llt.analyzed()) llt.analyze(H);  // a shared wrapper of another pattern is re-analyzed by factorize()
-    inf.seconds_factorization += since(t0);
+    inf.seconds_factorization += seconds_since(t0);
     bool factored = false;
     double delta = rel;
     const int n = static_cast<int>(H.rows());
@@ -387,7 +387,7 @@ bool factor_shifted(LinearSolver& llt, const Eigen::SparseMatrix<double>& H, con
         t0 = Clock::now();
         for (int j = 0; j < n; ++j) Hd.coeffRef(j, j) = H.coeff(j, j) + delta * diag[j];
         factored = llt.factorize(Hd, 0.0);
-        inf.seconds_one_factorization = since(t0);
+        inf.seconds_one_factorization = seconds_since(t0);
         inf.seconds_factorization += inf.seconds_one_factorization;
         ++inf.factorizations;
         if (factored) inf.delta = delta;
@@ -414,7 +414,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
     }
     if (n == 0) {  // nothing can relax: the modulus is the fixed-coordinate term
         for (size_t m = 0; m < modes.size(); ++m) out[m].value = modes[m].scale * out[m].E_tt, out[m].ok = true;
-        inf.seconds_total = since(t_start);
+        inf.seconds_total = seconds_since(t_start);
         return out;
     }
     // The shift is relative to each coordinate's own stiffness, H + delta D with D = |diag H| (a Jacobi-scaled
@@ -431,7 +431,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
     const ComovingRhs rhs = comoving_rhs(H, terms, out);
     const Eigen::MatrixXd &B = rhs.B, &V = rhs.V, &Vround = rhs.Vround;
     const std::vector<double>& comoving_size = rhs.size;
-    const double seconds_setup = since(t0);
+    const double seconds_setup = seconds_since(t0);
     const std::vector<Modulus> base = out;
     CholmodLLT own;
     LinearSolver& llt = shared_llt && shared_llt->definite() ? *shared_llt : own;  // a modulus needs the exact inverse
@@ -477,7 +477,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
             Mo.ok = std::isfinite(Mo.value) && !r.broke && (r.conv || cg_tail(r) <= 1e-7 * scale_ref[m]);
         }
         inf.message = failure_message(out, broke);
-        inf.seconds_solve += since(t0);
+        inf.seconds_solve += seconds_since(t0);
         for (const auto& m : out)
             if (!m.ok) return false;
         return true;
@@ -504,7 +504,7 @@ std::vector<Modulus> relaxed_moduli(const Eigen::SparseMatrix<double>& H, const 
     // A failed modulus has no value: NaN, so that a caller who forgets `ok` does not carry a plausible number on.
     for (auto& M : out)
         if (!M.ok) M.value = M.error = std::numeric_limits<double>::quiet_NaN();
-    inf.seconds_total = since(t_start);
+    inf.seconds_total = seconds_since(t_start);
     return out;
 }
 

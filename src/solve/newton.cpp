@@ -11,12 +11,12 @@
 #include "fibernet/solve/cholmod_llt.hpp"
 #include "fibernet/solve/newton_ladder.hpp"
 #include "fibernet/solve/solver_loop.hpp"
+#include "fibernet/util/stopwatch.hpp"
 
 namespace fibernet {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // |diagonal| of an upper-triangular CSC matrix (the diagonal is the last entry of each column; a column without one
 // contributes nothing), in column order, into d (kept by the caller across iterations).
@@ -84,7 +84,7 @@ CholmodLLT& NewtonSolver::analyzed_for(const Eigen::SparseMatrix<double>& H, dou
         // which on wet networks with many small regions is often never.
         if (H.rows() > 0 && !opt_.ldl) llt_->analyze(H);
         ldl_.reset();  // analyzed on first use (SolverOptions::ldl)
-        if (seconds) *seconds = since(t0);
+        if (seconds) *seconds = seconds_since(t0);
     }
     return *llt_;
 }
@@ -153,7 +153,7 @@ private:
         const auto t0 = Clock::now();
         projected_ = start_rung_ >= 1;
         fq_ = q.size() > 0 ? run.objective().hessian(q, g_, H_, projected_) : run.objective().value(q);
-        r.timings.assembly += since(t0);
+        r.timings.assembly += seconds_since(t0);
         follow_pattern(run.objective());
         gmax_ = q.size() > 0 ? g_.lpNorm<Eigen::Infinity>() : 0.0;
         if (!std::isfinite(fq_) || !g_.allFinite())
@@ -203,12 +203,12 @@ private:
         const auto ts = Clock::now();
         ne_->eliminate(run.objective(), q, local_tol_, time_left(run), [&](const Eigen::VectorXd& qs, int done, int total) {
             if (opt_.observe_within) opt_.observe_within(qs, [&] { return run.objective().value(qs); });
-            run.tick_within(it, done, total, since(ts));
+            run.tick_within(it, done, total, seconds_since(ts));
         });
         eliminating_ = ne_->at_trial_points();
         const auto ta = Clock::now();
         fq_ = run.objective().hessian(q, g_, H_, projected_);
-        run.result().timings.assembly += since(ta);
+        run.result().timings.assembly += seconds_since(ta);
         follow_pattern(run.objective());
         gmax_ = q.size() > 0 ? g_.lpNorm<Eigen::Infinity>() : 0.0;
         if (!std::isfinite(fq_) || !g_.allFinite())
@@ -244,7 +244,7 @@ private:
             const bool used_ldl = &rung == ldl_, modified = rung.modified();
             const auto tl = Clock::now();
             accepted = line_search(run, q, dm, level, alpha, ft, used_ldl && modified);
-            r.timings.line_search += since(tl);
+            r.timings.line_search += seconds_since(tl);
             step_ldl = accepted && used_ldl;
             if (accepted || !(used_ldl && modified)) break;
             ++r.ldl_retries;
@@ -363,7 +363,7 @@ SolveResult NewtonSolver::minimize(Objective& f, Eigen::VectorXd& q) {
         const auto t0 = Clock::now();
         ldl_ = std::make_unique<CholmodLDL>();
         ldl_->analyze(f.hessian_pattern());
-        run.result().timings.factorization += since(t0);
+        run.result().timings.factorization += seconds_since(t0);
     }
     NewtonLadder ladder(llt, opt_.ldl ? ldl_.get() : nullptr, !opt_.projected);
     std::vector<LinearSolver*> lins{&llt};

@@ -4,12 +4,11 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "fibernet/util/stopwatch.hpp"
+
 namespace fibernet {
 
 namespace {
-double since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 constexpr double kDescent = 1e-12;  // g.d < -kDescent |g| |d|
 constexpr double kLambda0 = 1e-8;   // escalations start here, relative to mean diag
 constexpr int kLambdaSteps = 11;    // level 2: lambda0 10^j, j = 0..10
@@ -24,12 +23,12 @@ bool LadderState::descent(const Eigen::VectorXd& d) const {
 bool LadderState::factor_and_solve(LinearSolver& lin, double shift, Eigen::VectorXd& d) {
     const auto tf = std::chrono::steady_clock::now();
     const bool ok = lin.factorize(H, shift);
-    result.timings.factorization += since(tf);
+    result.timings.factorization += seconds_since(tf);
     ++result.factorizations;
     if (!ok) return false;
     const auto ts = std::chrono::steady_clock::now();
     d = -lin.solve(g);
-    result.timings.solve += since(ts);
+    result.timings.solve += seconds_since(ts);
     return descent(d);
 }
 
@@ -42,7 +41,7 @@ void LadderState::make_projected() {
     // At the q of the exact Hessian, whose pattern already holds every non-zero element there.
     if (f.pattern_version() != version)
         throw std::logic_error("Newton: the Hessian pattern changed between two evaluations at the same state");
-    result.timings.assembly += since(ta);
+    result.timings.assembly += seconds_since(ta);
     projected = true;
 }
 

@@ -6,11 +6,12 @@
 #include <cstdint>
 #include <cstdio>
 
+#include "fibernet/util/stopwatch.hpp"
+
 namespace fibernet {
 
 namespace {
 using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // Restores a solver's options and the energy's pattern mode on every exit.
 struct OptionsGuard {
@@ -131,7 +132,7 @@ SmoothRelaxResult relax_smooth_wet(SmoothWetEnergy& W, Solver& solver, Eigen::Ve
         solve_in_rounds(W, solver, q, opt, guard.saved, R);
     R.list_builds = W.list_builds() - lists0, R.pattern_builds = W.pattern_builds() - patterns0;
     R.seconds_lists = W.seconds_lists() - seconds_lists0, R.seconds_patterns = W.seconds_patterns() - seconds_patterns0;
-    R.seconds = since(t0);
+    R.seconds = seconds_since(t0);
     return R;
 }
 

@@ -10,6 +10,11 @@ inline double wall_seconds() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// Seconds on the steady clock since t0.
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 class ScopedSeconds {
 public:
     explicit ScopedSeconds(double& total) : total_(total), t0_(std::chrono::steady_clock::now()) {}
