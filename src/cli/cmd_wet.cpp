@@ -317,7 +317,6 @@ nlohmann::json wet_settings_json(const Scene& s, const std::vector<double>& beta
         {"skin", s.wet.skin},
         {"checkpoint_seconds", s.wet.checkpoint_seconds},
         {"start_state", start ? start->record : nlohmann::json()},
-        {"coarsen", s.wet.coarsen},
         {"free_box", s.wet.free_box},
         {"free_box_shape", s.wet.free_box ? nlohmann::json(s.wet.free_box_shape) : nlohmann::json()},
         {"free_box_tol", s.wet.free_box ? nlohmann::json(s.wet.free_box_tol) : nlohmann::json()},
@@ -344,15 +343,6 @@ void sweep_row(std::ostream& sweep, double beta, const char* status, const WetRu
               << r.free_box.areal_shrinkage << "," << r.free_box.residual << "," << r.free_box.iterations << ","
               << r.free_box.shear_modulus;
     sweep << "\n";
-}
-
-// The smooth model's coarse stage (mesh sequencing), or null.
-nlohmann::json coarse_json(const WetRun& r) {
-    if (!r.sequenced) return nullptr;
-    const SmoothRelaxResult& c = r.coarse;
-    return {{"converged", c.converged}, {"message", c.message}, {"iterations", c.iterations},
-            {"factorizations", c.factorizations}, {"local_iterations", c.local_iterations}, {"grad_max", c.grad_max},
-            {"energy", c.energy}, {"seconds", c.seconds}};
 }
 
 // One run of summary.json's `runs` (docs/formats.md, "Wet scenes"); tol: the solver's, for its status.
@@ -395,7 +385,6 @@ nlohmann::json run_json(double beta, const char* status, const WetRun& r, const 
                                                                   {"local_iterations", r.smooth.local_iterations},
                                                                   {"eliminating_iterations",
                                                                    r.smooth.eliminating_iterations},
-                                                                  {"coarse", coarse_json(r)},
                                                                   {"seconds_patterns", r.smooth.seconds_patterns},
                                                                   {"seconds_lists", r.smooth.seconds_lists},
                                                                   {"seconds_solver",
@@ -580,7 +569,6 @@ public:
                            release();
                        }) {
         if (start_) in_.opt.wet_start = start_->q;
-        else if (in_.s.wet.coarsen > 1) in_.opt.coarse_model = std::make_shared<const Model>(discretize(net_, coarse()));
         if (checkpoints_.enabled()) {
             in_.opt.observe_wet = [this](const Eigen::VectorXd& q, double e, double g) { checkpoints_.observe(q, e, g); };
             in_.opt.observe_wet_within = [this](const Eigen::VectorXd& q, const std::function<double()>& e) {
@@ -620,14 +608,6 @@ public:
     }
 
 private:
-    // Mesh sequencing's coarse discretization ([wet].coarsen > 1).
-    DiscretizationParams coarse() const {
-        DiscretizationParams p = in_.s.discretization;
-        if (p.scheme == Scheme::Seed) p.n_seg /= in_.s.wet.coarsen;
-        else p.h *= in_.s.wet.coarsen;
-        return p;
-    }
-
     // --start-state, checked before any output: one beta only.
     std::optional<StartState> start_state() const {
         if (in_.s.wet.start_state.empty()) return std::nullopt;

@@ -91,13 +91,6 @@ void Scene::check_values() const {
     if (wet.model != "smooth" && !wet.start_state.empty())
         throw InputError(source + ": [wet].start_state = '" + wet.start_state +
                          "' applies to [wet].model = 'smooth' only (the event model's state includes its bridge set)");
-    check_value(wet.coarsen >= 1, wet.coarsen, source, "[wet].coarsen", "must be >= 1 (1: off)");
-    if (wet.coarsen > 1 && wet.model != "smooth")
-        throw InputError(source + ": [wet].coarsen = " + std::to_string(wet.coarsen) +
-                         " applies to [wet].model = 'smooth' only");
-    if (wet.coarsen > 1 && discretization.scheme == Scheme::Seed && discretization.n_seg / wet.coarsen < 1)
-        throw InputError(source + ": [wet].coarsen = " + std::to_string(wet.coarsen) + " leaves no segment of the " +
-                         std::to_string(discretization.n_seg) + " per fiber (n_seg)");
     if (wet.model != "smooth" && wet.newton_projected)
         throw InputError(source + ": [wet].newton_projected applies to [wet].model = 'smooth' only");
     if (wet.free_box_shape != "full" && wet.free_box_shape != "isotropic")

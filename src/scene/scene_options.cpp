@@ -180,10 +180,6 @@ std::vector<SceneOption> declare() {
              "smooth model, one beta: start the wet relaxation from this state file of the same network (a "
              "checkpoint_<k>.txt or state_<k>.txt of an earlier run) instead of the dry equilibrium",
              [](Scene& s) -> std::string& { return s.wet.start_state; }));
-    add(integer("wet", "coarsen", "--wet-coarsen",
-                "smooth model: relax first on the network discretized this many times coarser, then from there on the "
-                "scene's discretization (mesh sequencing; 1: off; docs/wet.md)",
-                [](Scene& s) -> int& { return s.wet.coarsen; }));
     return v;
 }
 

@@ -349,7 +349,7 @@ double capillary_pair_energy(const Vector8d& X, double l0a, double l0b, bool wet
         if (wet_crossing && S.blend > 0) parts->crossing_weight = S.blend * (S.WA * S.WB);
         if (S.blend < 1) parts->contact_weight = (1 - S.blend) * S.D, parts->overlap = S.overlap;
     }
-    const double lbar = 0.5 * (l0a + l0b) * p.crossing_length_scale;
+    const double lbar = 0.5 * (l0a + l0b);
     if (grad) grad->setZero();
     if (hess) hess->setZero();
     if (contact_grad) contact_grad->setZero();

@@ -8,7 +8,6 @@
 #include <limits>
 #include <sstream>
 
-#include "fibernet/model/prolong.hpp"
 #include "fibernet/util/error.hpp"
 #include "fibernet/util/stopwatch.hpp"
 #include "fibernet/wet/wet_moduli.hpp"
@@ -97,25 +96,6 @@ void smooth_run_free_box(WetRun& run, const NetworkEnergy& dry, const Eigen::Mat
     }
 }
 
-// Mesh sequencing's coarse stage: the same wet relaxation on the coarse model from its reference state (the dry
-// network at rest, carried affinely to F), its result in run.coarse; returns its state carried to the run's model,
-// as the run's start. The coarse stage need not converge: its state is only where the run's own relaxation starts.
-Eigen::VectorXd coarse_stage(WetRun& run, const NetworkEnergy& dry, const Eigen::Matrix2d& F, const FiberPairs& dry_pairs,
-                             const SmoothWetParams& sp, const WetRunOptions& opt, Solver& solver) {
-    const Model& coarse = *opt.coarse_model;
-    const NetworkEnergy dry_c(coarse);
-    Eigen::VectorXd q = dry_c.affine_map(dry_c.dofs(coarse.x), Eigen::Matrix2d::Identity(), F);
-    SmoothWetParams spc = sp;
-    spc.pair.crossing_length_scale = summarize(dry.model()).mean_segment / summarize(coarse).mean_segment;
-    SmoothWetEnergy W(dry_c, F, spc, dry_pairs, q);
-    SmoothRelaxOptions ro = opt.smooth_relax;
-    ro.observe = nullptr, ro.observe_within = nullptr;  // checkpoints are of the run's own model
-    run.coarse = relax_smooth_wet(W, solver, q, ro);
-    run.sequenced = true;
-    const Eigen::Matrix2d B = F * coarse.box.B0();
-    return dry.dofs(prolong_positions(coarse, dry_c.positions(q, F), B, dry.model()));
-}
-
 // The smooth model's wet relaxation and what follows it (run_wet's second half).
 void run_wet_smooth(WetRun& run, const Network& net, const NetworkEnergy& dry, const Eigen::Matrix2d& F,
                     const WetRunOptions& opt, Solver& solver) {
@@ -129,17 +109,15 @@ void run_wet_smooth(WetRun& run, const Network& net, const NetworkEnergy& dry, c
     if (sp.pair.crossing_width <= 0) sp.pair.crossing_width = r;
     if (sp.pair.contact <= 0) sp.pair.contact = 2 * r;
     if (sp.pair.overlap_width <= 0) sp.pair.overlap_width = r;
-    run.wet.q = opt.wet_start.size() ? opt.wet_start
-                : opt.coarse_model     ? coarse_stage(run, dry, F, dry_pairs, sp, opt, solver)
-                                       : run.dry.q;
+    run.wet.q = opt.wet_start.size() ? opt.wet_start : run.dry.q;
     SmoothWetEnergy W(dry, F, sp, dry_pairs, run.wet.q);
     run.initial_bridges = W.bridges(run.wet.q);
     SmoothRelaxOptions ro = opt.smooth_relax;
     ro.observe = opt.observe_wet;
     ro.observe_within = opt.observe_wet_within;
     run.smooth = relax_smooth_wet(W, solver, run.wet.q, ro);
-    run.seconds_wet_solve = run.smooth.seconds + run.coarse.seconds;
-    run.active.seconds_solve = run.seconds_wet_solve;
+    run.seconds_wet_solve = run.smooth.seconds;
+    run.active.seconds_solve = run.smooth.seconds;
     run.wet.converged = run.smooth.converged;
     run.active.last = run.smooth.last;
     run.active.rounds = run.smooth.rounds;

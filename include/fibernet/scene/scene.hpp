@@ -67,10 +67,6 @@ struct WetSettings {
     double skin = 0.5;
     double checkpoint_seconds = 300;  // smooth model with -o: the wet relaxation's state written this often; 0: never
     std::string start_state;          // smooth model: the wet relaxation starts from this state file (one beta)
-    // Smooth model: mesh sequencing (docs/wet.md, "Mesh sequencing"): the wet relaxation first on the same network
-    // discretized coarsen times coarser (seed scheme: n_seg / coarsen segments per fiber; even: h x coarsen), its
-    // equilibrium carried to the scene's discretization as the start of its own. 1: off.
-    int coarsen = 1;
 };
 
 struct Scene {

@@ -47,9 +47,6 @@ struct CapillaryPairParams {
     double overlap_width = 0.1;   // w: smoothing of the overlap's ends
     double angle_lo_deg = 10;     // below: contact term only
     double angle_hi_deg = 20;     // above: crossing term only
-    // The crossing term's length lbar is the pair's mean rest length times this (mesh sequencing's coarse stage: the
-    // ratio of the two discretizations' segment lengths, so that a crossing exerts the torque it has in the fine one).
-    double crossing_length_scale = 1;
 
     // Largest distance between two segments (current length at most `max_length` each) at which a term can be
     // non-zero: the crossing term needs both segments within eps of the other's line, so both within eps / sin

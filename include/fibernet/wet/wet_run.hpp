@@ -6,7 +6,6 @@
 #include <Eigen/Core>
 #include <functional>
 #include <limits>
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -50,10 +49,6 @@ struct WetRunOptions {
     // The smooth model only (InputError otherwise): the wet relaxation starts from these coordinates (the dry energy's
     // dofs, e.g. a checkpoint of an interrupted run) instead of the dry equilibrium; empty: from the dry equilibrium.
     Eigen::VectorXd wet_start;
-    // The smooth model, without wet_start: mesh sequencing (docs/wet.md, "Mesh sequencing"). The wet relaxation runs
-    // first on this coarser discretization of the same network, from its reference state, and its equilibrium,
-    // carried to the run's model (prolong_positions), is where the run's own relaxation starts. Null: none.
-    std::shared_ptr<const Model> coarse_model;
     // The smooth model: called with each accepted iterate of the fixed-box wet relaxation (not of the moduli's or the
     // free box's relaxations), e.g. to write checkpoints (SolverOptions::observe); empty: none.
     std::function<void(const Eigen::VectorXd& q, double energy, double grad_max)> observe_wet;
@@ -80,8 +75,6 @@ struct WetRun {
     SolveResult dry_solve;
     ActiveSetResult active;        // the wet relaxation (the smooth model fills bridges, last, rounds, stable, message)
     SmoothRelaxResult smooth;      // the smooth model's relaxation
-    SmoothRelaxResult coarse;      // its coarse stage (WetRunOptions::coarse_model), if any
-    bool sequenced = false;        // the coarse stage ran
     std::vector<Bridge> initial_bridges;
     BundleStats bundles;
     FreeBoxResult free_box;        // attempted only if asked and the fixed-box wet state is stable
