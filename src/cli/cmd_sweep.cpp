@@ -345,7 +345,8 @@ void register_sweep(CLI::App& app) {
             if (!csv) throw OutputError("cannot append step " + std::to_string(r.step) + " to '" + *out + "'");
             if (series.on())
                 series.add(r.step, r.t, e, st.q, deformation(p->kind, r.t),
-                           {{}, {{"gamma", r.t}, {"stress_path", r.stress_path}, {"dsdgamma", r.K}, {"energy", r.energy}}});
+                           {{}, {{"gamma", r.t}, {"stress_path", r.stress_path}, {"dsdgamma", r.K}, {"energy", r.energy}},
+                            {}, {}});
             write_checkpoint(*ckpt, params, ++rows, st);
             last = st;
             if (!*quiet) lines.step(r);

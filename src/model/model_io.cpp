@@ -114,7 +114,7 @@ struct Reader {
 }  // namespace
 
 Model read_model(std::istream& is, const std::string& source, Eigen::VectorXd* uout, Eigen::Matrix2d* Fout) {
-    Reader r{is, source};
+    Reader r{is, source, 0, {}};
     Model m;
     int version = 0;
     {

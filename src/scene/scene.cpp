@@ -231,7 +231,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
         return t ? *t : empty;
     };
     for (const char* name : {"network", "model", "load", "solver", "wet"}) {
-        TableReader r{table(name), source + ": [" + name + "]"};
+        TableReader r{table(name), source + ": [" + name + "]", {}};
         for (const SceneOption& o : scene_options())
             if (o.table == name) read_option(r, o, s);
         if (std::string(name) == "network") {

@@ -258,7 +258,7 @@ private:
                                   : retried ? " (after LDL^T)" : "",
                          shift, accepted ? alpha : 0.0);
         if (!accepted) return false;
-        update_shift(level, shift, alpha, ft, mu, dm, retried);
+        update_shift(level, shift, alpha, ft, mu, retried);
         start_rung_ = next_start(level, alpha);
         return true;
     }
@@ -307,7 +307,7 @@ private:
     // Shift update (Nielsen-like): shrink after a full step the quadratic model predicted well, grow after
     // backtracking or a poor prediction. Near a minimum every step is full and predicted, so the shift falls 10x per
     // iteration and the convergence becomes quadratic.
-    void update_shift(int level, double shift, double alpha, double ft, double mu, double dm, bool retried) {
+    void update_shift(int level, double shift, double alpha, double ft, double mu, bool retried) {
         if (level > 2) return;
         const Eigen::VectorXd Hd = H_.selfadjointView<Eigen::Upper>() * d_;
         const double pred = -(alpha * g_.dot(d_) + 0.5 * alpha * alpha * d_.dot(Hd));

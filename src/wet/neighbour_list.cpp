@@ -13,7 +13,9 @@
 
 namespace fibernet {
 
-namespace {
+// A named namespace, not an anonymous one: NeighbourList::Cache (external linkage) holds these types, which GCC flags
+// (-Wsubobject-linkage) when this file is compiled inside a unity batch.
+namespace neighbour_cells {
 
 // A segment's ends moved next to its wrapped midpoint (node i's unwrapped position is x_i - B wrap), and the distance
 // within which its pairs are listed.
@@ -36,7 +38,7 @@ struct Entry {
     Eigen::Vector2i t;
 };
 
-}  // namespace
+}  // namespace neighbour_cells
 
 NeighbourList::NeighbourList(const Model& m, std::function<double(double)> range, double skin)
     : m_(m), range_(std::move(range)), skin_(skin) {
@@ -60,7 +62,7 @@ Eigen::Matrix<double, 8, 1> NeighbourList::coordinates(const SegmentPair& p, con
     return X;
 }
 
-namespace {
+namespace neighbour_cells {
 
 // The segments' ends next to their wrapped midpoints and their reaches, in the frame of the grid's box G (the periodic
 // box B, or for an open box a box around every segment, far larger than any reach, without images).
@@ -116,13 +118,14 @@ Frame segment_frame(const Model& m, const Eigen::VectorXd& x, const Eigen::Matri
 
 // Each segment's grown box entered into every cell of the grid it covers (cells about twice the mean reach a side,
 // widths measured across the box's sides), and per segment the cells it covers.
-struct Grid {
+struct CellGrid {
     int nx = 1, ny = 1;
     std::vector<std::vector<Entry>> cell, covers;  // covers: k is the cell's index
 };
 
 // The cells (with wraps) that segment g's box grown by `grow` covers; false if some of it lies outside an open box's grid.
-bool cells_of(const SegInfo& g, double grow, const Frame& fr, const Grid& grid, bool periodic, std::vector<Entry>& out) {
+bool cells_of(const SegInfo& g, double grow, const Frame& fr, const CellGrid& grid, bool periodic,
+              std::vector<Entry>& out) {
     out.clear();
     bool inside = true;
     const int nx = grid.nx, ny = grid.ny;
@@ -149,10 +152,10 @@ bool cells_of(const SegInfo& g, double grow, const Frame& fr, const Grid& grid, 
     return inside;
 }
 
-Grid cover_cells(const std::vector<SegInfo>& seg, const Frame& fr, bool periodic) {
+CellGrid cover_cells(const std::vector<SegInfo>& seg, const Frame& fr, bool periodic) {
     const int ns = static_cast<int>(seg.size());
     const double area = std::abs(fr.G.determinant()), side = std::max(2 * fr.mean_reach, 1e-9);
-    Grid grid;
+    CellGrid grid;
     grid.nx = std::max(1, static_cast<int>(std::floor(area / fr.G.col(1).norm() / side)));
     grid.ny = std::max(1, static_cast<int>(std::floor(area / fr.G.col(0).norm() / side)));
     grid.cell.resize(static_cast<size_t>(grid.nx) * grid.ny);
@@ -166,8 +169,9 @@ Grid cover_cells(const std::vector<SegInfo>& seg, const Frame& fr, bool periodic
 
 // Segment a's pairs: every b > a of another fiber sharing a cell, each (b, image) tested once (a mark per b, in
 // seen_a / seen_image), within range + skin exactly, sorted by b and image.
-void pairs_of(int a, const Model& m, const std::vector<SegInfo>& seg, const Grid& grid, const Frame& fr, double skin,
-              std::vector<int>& seen_a, std::vector<Eigen::Vector2i>& seen_image, std::vector<SegmentPair>& out) {
+void pairs_of(int a, const Model& m, const std::vector<SegInfo>& seg, const CellGrid& grid, const Frame& fr,
+              double skin, std::vector<int>& seen_a, std::vector<Eigen::Vector2i>& seen_image,
+              std::vector<SegmentPair>& out) {
     const SegInfo& A = seg[a];
     const Segment& sa = m.segments[a];
     for (const Entry& ca : grid.covers[a])
@@ -198,14 +202,14 @@ void pairs_of(int a, const Model& m, const std::vector<SegInfo>& seg, const Grid
               out.end());
 }
 
-}  // namespace
+}  // namespace neighbour_cells
 
 // What a full build keeps for update(): the grid's frame, the segments' cells and their ends, wraps and reaches as
 // last entered.
 struct NeighbourList::Cache {
-    Frame fr;
-    Grid grid;
-    std::vector<SegInfo> seg;
+    neighbour_cells::Frame fr;
+    neighbour_cells::CellGrid grid;
+    std::vector<neighbour_cells::SegInfo> seg;
     // find()'s work arrays, per segment, kept so that a search costs the segments it moves, not the network: whether
     // a segment is one of those moved (in, cleared after), the pass that last met it next to a moved segment and at
     // which image (seen, seen_image: each (b, image) is tested once per moved segment, not once per cell they share),
@@ -214,12 +218,12 @@ struct NeighbourList::Cache {
         std::vector<char> in;
         std::vector<long> seen, info_pass;
         std::vector<Eigen::Vector2i> seen_image;
-        std::vector<SegInfo> info;
+        std::vector<neighbour_cells::SegInfo> info;
         long pass = 0;
         void size(size_t ns) {
             if (in.size() == ns) return;
             in.assign(ns, 0), seen.assign(ns, -1), info_pass.assign(ns, -1);
-            seen_image.assign(ns, Eigen::Vector2i::Zero()), info.assign(ns, SegInfo{});
+            seen_image.assign(ns, Eigen::Vector2i::Zero()), info.assign(ns, neighbour_cells::SegInfo{});
         }
     } scratch;
 };
@@ -235,11 +239,12 @@ bool pair_equal(const SegmentPair& p, const SegmentPair& q) { return p.a == q.a 
 }  // namespace
 
 void NeighbourList::build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, double skin) {
+    using namespace neighbour_cells;
     const int ns = static_cast<int>(m_.segments.size());
     built_skin_ = std::max(skin, skin_);
     std::vector<SegInfo> seg;
     const Frame fr = segment_frame(m_, x, B, range_, built_skin_, seg);
-    Grid grid = cover_cells(seg, fr, m_.box.periodic);
+    CellGrid grid = cover_cells(seg, fr, m_.box.periodic);
     std::vector<std::vector<SegmentPair>> found(ns);
     parallel_ranges(ns, ns >= 2048 ? thread_count() : 1, [&](size_t lo, size_t hi) {
         std::vector<int> seen_a(ns, -1);
@@ -264,6 +269,7 @@ void NeighbourList::build(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, do
 
 bool NeighbourList::find(const Eigen::VectorXd& x, const Eigen::Matrix2d& B, const std::vector<int>& segments,
                          const std::vector<int>& nodes, std::vector<SegmentPair>& found) {
+    using namespace neighbour_cells;
     if (!cache_ || builds_ == 0 || B != B_built_ || x.size() != x_built_.size()) return build(x, B), false;
     if (cache_.use_count() > 1) cache_ = std::make_shared<Cache>(*cache_);  // copies of this list keep theirs
     Cache& c = *cache_;

@@ -83,9 +83,9 @@ TEST_CASE("discretize: coincident pins on a fiber become one supernode", "[model
     Network net;
     net.L = 10;
     net.periodic = false;
-    net.fibers.push_back({Eigen::Vector2d(0, 0), 0.0, 1.0});
-    net.fibers.push_back({Eigen::Vector2d(0, 0), M_PI / 3, 1.0});
-    net.fibers.push_back({Eigen::Vector2d(0.5, -0.5), M_PI / 2, 1.0});
+    net.fibers.push_back({Eigen::Vector2d(0, 0), 0.0, 1.0, {}});
+    net.fibers.push_back({Eigen::Vector2d(0, 0), M_PI / 3, 1.0, {}});
+    net.fibers.push_back({Eigen::Vector2d(0.5, -0.5), M_PI / 2, 1.0, {}});
     auto pin = [&](int a, int b, double sa, double sb) {
         Crossing c;
         c.f1 = a, c.f2 = b, c.s1 = sa, c.s2 = sb, c.crosslink = true;

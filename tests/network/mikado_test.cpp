@@ -124,7 +124,7 @@ TEST_CASE("network: connected components of the crosslink graph", "[network]") {
     Network net;
     net.L = 10;
     net.periodic = false;
-    for (int i = 0; i < 4; ++i) net.fibers.push_back({Eigen::Vector2d(i, 0), 0.0, 1.0});
+    for (int i = 0; i < 4; ++i) net.fibers.push_back({Eigen::Vector2d(i, 0), 0.0, 1.0, {}});
     Crossing c;
     c.f1 = 0, c.f2 = 1, c.crosslink = true;
     net.crossings.push_back(c);
