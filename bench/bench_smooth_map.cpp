@@ -11,6 +11,7 @@
 //   bench_smooth_map [--out DIR] [--L 3] [--q 6,10] [--a 10,100] [--schemes seed,even] [--betas 0.01,0.1,1]
 //                    [--solvers newton,newton+eliminate,...] [--budget 4] [--partners 2] [--seed 1] [--best-tol 1e-6]
 // Writes DIR/stability_smooth.csv (one row per scene and solver); progress on stderr.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -23,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_text.hpp"
 #include "deadline_solver.hpp"
 #include "fibernet/energy/network_energy.hpp"
 #include "fibernet/model/discretize.hpp"
@@ -32,7 +34,9 @@
 #include "fibernet/wet/wet_run.hpp"
 
 using namespace fibernet;
+using bench::csv_text;
 using bench::DeadlineSolver;
+using bench::split;
 
 namespace {
 
@@ -46,14 +50,6 @@ struct MapOptions {
     std::uint64_t seed = 1;
     std::string out = "docs/solvers";
 };
-
-std::vector<std::string> split(const std::string& s) {
-    std::vector<std::string> out;
-    std::stringstream ss(s);
-    for (std::string item; std::getline(ss, item, ',');)
-        if (!item.empty()) out.push_back(item);
-    return out;
-}
 
 std::vector<double> numbers(const std::string& key, const std::string& s) {
     std::vector<double> out;
@@ -76,6 +72,13 @@ double one_number(const std::string& key, const std::string& s) {
     const auto v = numbers(key, s);
     if (v.size() != 1) throw std::runtime_error("--" + key + " takes one number, not '" + s + "'");
     return v[0];
+}
+
+long whole_number(const std::string& key, const std::string& s) {
+    const double v = one_number(key, s);
+    if (!(v >= 0 && v <= 1e15 && v == std::floor(v)))
+        throw std::runtime_error("--" + key + " '" + s + "' must be a whole number >= 0");
+    return static_cast<long>(v);
 }
 
 // The solver of a map name: a registry name, or newton with elimination or the Schwarz sweep as the wet command sets
@@ -123,12 +126,6 @@ Run relax(const NetworkEnergy& dry, const FiberPairs& dry_pairs, const SmoothWet
     if (run.r.grad_max <= 1e-6 && std::isnan(run.t_1e6)) run.t_1e6 = run.seconds;  // the start, or the last round
     if (run.r.grad_max <= 1e-10 && std::isnan(run.t_1e10)) run.t_1e10 = run.seconds;
     return run;
-}
-
-std::string csv_text(std::string s) {
-    for (char& c : s)
-        if (c == ',' || c == '"' || c == '\n') c = ';';
-    return "\"" + s + "\"";
 }
 
 // One scene: the network, its discretization and the smooth energy's parameters as run_wet_smooth sets them.
@@ -195,12 +192,11 @@ MapOptions parse(int argc, char** argv) {
         else if (k == "solvers") o.solvers = split(v);
         else if (k == "budget") o.budget = one_number(k, v);
         else if (k == "best-tol") o.best_tol = one_number(k, v);
-        else if (k == "partners") o.partners = static_cast<int>(one_number(k, v));
-        else if (k == "seed") o.seed = static_cast<std::uint64_t>(one_number(k, v));
+        else if (k == "partners") o.partners = static_cast<int>(std::min(whole_number(k, v), 1000000L));
+        else if (k == "seed") o.seed = static_cast<std::uint64_t>(whole_number(k, v));
         else throw std::runtime_error("unknown option --" + k);
     }
     if (!(o.budget > 0)) throw std::runtime_error("--budget must be > 0 seconds");
-    if (o.partners < 0) throw std::runtime_error("--partners must be >= 0 (0: no cap)");
     for (double b : o.betas)
         if (!(b > 0)) throw std::runtime_error("--betas must be > 0");
     for (const auto& s : o.schemes) parse_scheme(s);

@@ -52,6 +52,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_text.hpp"
 #include "deadline_solver.hpp"
 #include "fibernet/box/box.hpp"
 #include "fibernet/energy/network_energy.hpp"
@@ -96,14 +97,7 @@ std::vector<std::string> bench_solver_names() {
     return names;
 }
 
-std::vector<std::string> split(const std::string& s) {
-    std::vector<std::string> out;
-    std::stringstream ss(s);
-    std::string item;
-    while (std::getline(ss, item, ','))
-        if (!item.empty()) out.push_back(item);
-    return out;
-}
+using bench::split;
 std::vector<double> split_d(const std::string& s) {
     std::vector<double> out;
     for (const auto& x : split(s)) out.push_back(std::stod(x));
@@ -208,11 +202,7 @@ double time_to(const std::vector<Sample>& s, double thr) {
 
 using bench::DeadlineSolver;
 
-std::string csv_text(std::string s) {
-    std::replace(s.begin(), s.end(), ',', ';');
-    std::replace(s.begin(), s.end(), '"', '\'');
-    return "\"" + s + "\"";
-}
+using bench::csv_text;
 
 struct WetGrid {
     std::vector<double> Ls, qs, as, gammas, betas;
