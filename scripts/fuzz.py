@@ -50,7 +50,7 @@ import tempfile
 import time
 import random
 
-from fibernet_runs import child_env, child_limits, parse_json
+from fibernet_runs import child_env, child_limits, parse_json, sanitized
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FORMATS = ["network", "scene", "law", "sweep_ckpt", "percolation", "model", "foreign", "paths", "points"]
@@ -378,11 +378,21 @@ class Result:
     pass
 
 
+# True when the fibernet under test is built with AddressSanitizer (set in main): no address-space limit, a cap per
+# allocation instead, and a longer timeout (fibernet_runs.child_limits).
+ASAN = False
+# ASan and UBSan at -O1 (scripts/sanitize.sh) run fibernet a few times slower than the Release build.
+ASAN_SLOWDOWN = 4
+
+
 def run(argv, cwd, timeout):
+    asan = ASAN
+    if asan:
+        timeout *= ASAN_SLOWDOWN
     r = Result()
     t0 = time.monotonic()
     p = subprocess.Popen(argv, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                         env=child_env(), preexec_fn=lambda: child_limits(3, 256))
+                         env=child_env(3, asan), preexec_fn=lambda: child_limits(3, 256, asan))
     r.timed_out = False
     try:
         r.out, r.err = p.communicate(timeout=timeout)
@@ -1260,21 +1270,23 @@ def save_repro(outdir, case, category, detail, r, fib):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seed", type=int, default=DEFAULT_SEED, help="master seed (default %(default)s)")
-    ap.add_argument("--cases", type=int, default=200, help="cases per format (default %(default)s)")
+    ap.add_argument("--cases", type=int, default=None, help="cases per format (default 200; 30 with --smoke)")
     ap.add_argument("--fibernet", default=os.path.join(REPO, "build", "fibernet"),
                     help="the fibernet executable (default: build/fibernet of the repository)")
     ap.add_argument("--out", default=os.path.join(tempfile.gettempdir(), "fibernet-fuzz-failures"),
                     help="directory for failing reproducers (default %(default)s)")
     ap.add_argument("--timeout", type=float, default=10, help="seconds per case (default %(default)s)")
     ap.add_argument("--formats", default=",".join(FORMATS), help="comma-separated subset of: " + ", ".join(FORMATS))
-    ap.add_argument("--smoke", action="store_true", help="a small fixed number of cases per format (30) and a 5 s timeout: the ctest entry")
+    ap.add_argument("--smoke", action="store_true", help="30 cases per format (unless --cases says otherwise) and a 5 s timeout: the ctest entry")
     ap.add_argument("--keep", type=int, default=3, help="reproducers kept per (format, category) (default %(default)s)")
     ap.add_argument("--time-budget", type=float, default=0, help="stop starting cases after this many seconds (0: none)")
     ap.add_argument("--start", type=int, default=0, help="first case index (default 0), e.g. to rerun one case")
     ap.add_argument("-v", "--verbose", action="store_true", help="print every failure as it happens")
     a = ap.parse_args()
     if a.smoke:
-        a.cases, a.timeout = 30, min(a.timeout, 5)
+        a.cases, a.timeout = a.cases if a.cases is not None else 30, min(a.timeout, 5)
+    elif a.cases is None:
+        a.cases = 200
     formats = [f.strip() for f in a.formats.split(",") if f.strip()]
     for f in formats:
         if f not in FORMATS:
@@ -1282,6 +1294,11 @@ def main():
     fib = os.path.abspath(a.fibernet)
     if not os.access(fib, os.X_OK):
         ap.error("--fibernet %s is not an executable" % fib)
+    global ASAN
+    ASAN = sanitized(fib)
+    if ASAN:
+        print("fuzz: %s is built with AddressSanitizer: no address-space limit (a cap per allocation instead), "
+              "timeouts x%d" % (fib, ASAN_SLOWDOWN), file=sys.stderr)
     outdir = os.path.abspath(a.out)
     work = tempfile.mkdtemp(prefix="fibernet-fuzz-")
     t_start = time.monotonic()

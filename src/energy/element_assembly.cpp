@@ -133,8 +133,10 @@ void ElementAssembly::scatter_serially(const ElementFrame& frame, const ElementW
     for (std::size_t k = 0; k < terms_.size(); ++k) {
         const ElementTerm* t = terms_[k];
         const int M = 2 * t->valence(), U = upper_count(M);
-        const int* idx = &coord_index_[coord_offset_[k]];
-        const int* slot = &upper_slot_[upper_offset_[k]];
+        // data() + offset, not &v[offset]: a term with no elements may end the arrays (or leave them empty), and
+        // operator[] one past the end is undefined even when nothing is read through it.
+        const int* idx = coord_index_.data() + coord_offset_[k];
+        const int* slot = upper_slot_.data() + upper_offset_[k];
         for (std::size_t e = 0; e < t->size(); ++e, idx += M, slot += U) {
             t->evaluate(e, frame, w, r);
             sums.energy[k] += r.energy;

@@ -18,6 +18,8 @@ using clitest::slurp;
 using clitest::tmpdir;
 
 namespace {
+// The parsed file, or a discarded value when it is missing or not JSON. The results are indexed without const: a
+// missing key or run then reads as null and fails its CHECK, where const operator[] would be undefined behaviour.
 nlohmann::json read_json(const std::string& path) { return nlohmann::json::parse(slurp(path), nullptr, false); }
 
 // A 64-fiber network whose smooth relaxation at beta = 0.1 takes a few hundred Newton iterations.
@@ -38,12 +40,14 @@ TEST_CASE("wet checkpoint: an unconverged relaxation leaves its last state, and 
     REQUIRE(run("wet " + short_scene() + " " + kNetwork + " -q --betas 0.1 -o " + a) == 1);
     CHECK(slurp(tmpdir() + "/stderr").find("did not converge; its last state is " + a + "/checkpoint_0.txt") !=
           std::string::npos);
-    const nlohmann::json s = read_json(a + "/summary.json");
+    nlohmann::json s = read_json(a + "/summary.json");
+    REQUIRE(s.is_object());
+    REQUIRE(s["runs"].size() == 1);
     CHECK(s["runs"][0]["status"] == "not_stable");
     CHECK(s["runs"][0]["checkpoint"] == "checkpoint_0.txt");
     CHECK(!exists(a + "/state_0.txt"));  // an unconverged state is no result
     REQUIRE(slurp(a + "/checkpoint_0.txt").rfind("fibernet-model 2\n", 0) == 0);
-    const nlohmann::json c = read_json(a + "/checkpoint_0.json");
+    nlohmann::json c = read_json(a + "/checkpoint_0.json");
     REQUIRE(c.is_object());
     CHECK(c["fibernet_checkpoint"] == "wet");
     CHECK(c["last"] == true);
@@ -70,8 +74,10 @@ TEST_CASE("wet checkpoint: an unconverged relaxation leaves its last state, and 
     REQUIRE(first != std::string::npos);
     const double e_start = std::strtod(trace.c_str() + first + 17, nullptr);
     CHECK(std::abs(e_start - e_checkpoint) <= 1e-12 * std::abs(e_checkpoint));
-    const nlohmann::json t = read_json(b + "/summary.json");
-    const nlohmann::json& r = t["runs"][0];
+    nlohmann::json t = read_json(b + "/summary.json");
+    REQUIRE(t.is_object());
+    REQUIRE(t["runs"].size() == 1);
+    nlohmann::json& r = t["runs"][0];
     CHECK(r["status"] == "stable");
     CHECK(r["smooth"]["grad_max"].get<double>() <= 1e-8);
     CHECK(r["energy"]["wet"]["total"].get<double>() <= e_checkpoint + 1e-9 * std::abs(e_checkpoint));
@@ -102,7 +108,7 @@ TEST_CASE("wet checkpoint: the Schwarz sweep is checkpointed between its local s
     CHECK(e_within < 0);
     CHECK(e_first <= e_within + 1e-9 * std::abs(e_within));
     // The last state is a whole iterate's: the JSON says so and carries its max|g|.
-    const nlohmann::json c = read_json(a + "/checkpoint_0.json");
+    nlohmann::json c = read_json(a + "/checkpoint_0.json");
     REQUIRE(c.is_object());
     CHECK(c["last"] == true);
     CHECK(c["within_iteration"] == false);
@@ -123,7 +129,7 @@ TEST_CASE("wet checkpoint: a running relaxation's checkpoints survive SIGINT", "
     REQUIRE(WIFEXITED(st));
     CHECK(WEXITSTATUS(st) == 130);
     CHECK(slurp(tmpdir() + "/bg_stderr").find("--start-state " + out + "/checkpoint_0.txt") != std::string::npos);
-    const nlohmann::json c = read_json(out + "/checkpoint_0.json");
+    nlohmann::json c = read_json(out + "/checkpoint_0.json");
     REQUIRE(c.is_object());
     CHECK(c["last"] == false);
     CHECK(c["iterations"].get<int>() >= 1);

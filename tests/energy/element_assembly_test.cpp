@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "fd.hpp"
 #include "fibernet/energy/network_energy.hpp"
 #include "fibernet/model/discretize.hpp"
 #include "fibernet/network/mikado.hpp"
@@ -144,6 +145,81 @@ TEST_CASE("element assembly: parallel assembly is bit for bit the serial one", "
             CHECK(f.hash == serial.hash);
             CHECK(f.energy == serial.energy);
         }
+    }
+    set_thread_count(0);
+}
+
+TEST_CASE("element assembly: a term with no elements (fibers of one segment, no hinges)", "[energy][assembly]") {
+    // Two fibers that do not cross, one segment each: the bending term has no element, and its index arrays end
+    // where the stretching term's end (or are empty). The sum is the stretching energy alone, with its derivatives.
+    Network net;
+    net.L = 3, net.periodic = true;
+    Fiber a, b;
+    a.start = {0.2, 0.5}, a.theta = 0.3;
+    b.start = {0.4, 2.0}, b.theta = 2.0;
+    net.fibers = {a, b};
+    DiscretizationParams d;
+    d.scheme = Scheme::Seed, d.n_seg = 1, d.aspect_ratio = 10;
+    const Model m = discretize(net, d);
+    REQUIRE(m.hinges.empty());
+    REQUIRE(m.segments.size() == 2);
+    const NetworkEnergy e(m);
+    Eigen::Matrix2d F, dF;
+    F << 1.02, 0.1, 0, 0.97, dF << 0, 1, 0, 0;
+    Eigen::VectorXd q = e.dofs(e.model().x);
+    Rng rng(5);
+    for (int i = 0; i < q.size(); ++i) q[i] += 0.3 * (2 * rng.uniform() - 1);
+    for (int threads : {1, 2}) {
+        set_thread_count(threads);
+        EnergyEval ev;
+        Eigen::SparseMatrix<double> H = e.hessian_pattern();
+        e.evaluate(q, F, dF, kGradient | kHessian | kStrain, ev, &H);
+        INFO("threads " << threads);
+        CHECK(ev.bend == 0);
+        CHECK(ev.stretch > 0);
+        CHECK(ev.energy == ev.stretch);
+        const auto value = [&](const Eigen::VectorXd& x) {
+            EnergyEval v;
+            e.evaluate(x, F, dF, kValue, v, nullptr);
+            return v.energy;
+        };
+        const Eigen::VectorXd g = fdtest::fd_gradient(value, q, 1e-6);
+        CHECK((ev.gradient - g).cwiseAbs().maxCoeff() <= 1e-6 * g.cwiseAbs().maxCoeff());
+        const auto gradient = [&](const Eigen::VectorXd& x) {
+            EnergyEval v;
+            e.evaluate(x, F, dF, kGradient, v, nullptr);
+            return Eigen::VectorXd(v.gradient);
+        };
+        const Eigen::MatrixXd Hfd = fdtest::fd_jacobian(gradient, q, 1e-6);
+        const Eigen::MatrixXd Hd = Eigen::MatrixXd(Eigen::MatrixXd(H).selfadjointView<Eigen::Upper>());
+        CHECK((Hd - Hfd).cwiseAbs().maxCoeff() <= 1e-6 * Hfd.cwiseAbs().maxCoeff());
+    }
+    set_thread_count(0);
+}
+
+TEST_CASE("element assembly: a model with no elements at all (an empty network)", "[energy][assembly]") {
+    // Every term empty: the assembler's index arrays hold nothing, and the sums are zero.
+    Network net;
+    net.L = 2, net.periodic = true;
+    DiscretizationParams d;
+    d.scheme = Scheme::Even, d.h = 1.0, d.aspect_ratio = 10;
+    const Model m = discretize(net, d);
+    REQUIRE(m.segments.empty());
+    REQUIRE(m.hinges.empty());
+    const NetworkEnergy e(m);
+    Eigen::Matrix2d F, dF;
+    F << 1, 0.1, 0, 1, dF << 0, 1, 0, 0;
+    const Eigen::VectorXd q = e.dofs(e.model().x);
+    for (int threads : {1, 2}) {
+        set_thread_count(threads);
+        EnergyEval ev;
+        Eigen::SparseMatrix<double> H = e.hessian_pattern();
+        e.evaluate(q, F, dF, kGradient | kHessian | kStrain, ev, &H);
+        INFO("threads " << threads);
+        CHECK(ev.energy == 0);
+        CHECK(ev.dE_dt == 0);
+        CHECK(ev.gradient.size() == q.size());
+        CHECK(H.nonZeros() == 0);
     }
     set_thread_count(0);
 }

@@ -105,7 +105,7 @@ TEST_CASE("sweep: compression through buckling keeps every accepted step converg
     CHECK(rows.back().bend > 0);
 }
 
-TEST_CASE("sweep: a snap-through beyond the solver's budget is crossed with the snap budget", "[mechanics][sweep]") {
+TEST_CASE("sweep: a snap-through beyond the solver's budget is crossed with the snap budget", "[mechanics][sweep][slow]") {
     // Shear of a 4 x 4 network to 40%: fibers buckle in cascades; measured with `fibernet sweep --L 4 --q 8
     // --scheme even --gamma-max 0.5 --min-step 1e-3 --max-iter 20`, steps at the smallest size need 100s of iterations.
     Model m = sweep_model(8, 10, 4, 1, 1.0);

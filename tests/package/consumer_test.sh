@@ -16,7 +16,12 @@ for f in bin/fibernet include/fibernet/mechanics/moduli.hpp include/fibernet/wet
 done
 [ -n "$libdir" ] && [ -f "$libdir/fibernetConfig.cmake" ] || fail "no fibernetConfig.cmake under $tmp/prefix/lib*/cmake/fibernet"
 
-cmake -S "$src/examples" -B "$tmp/examples" -DCMAKE_PREFIX_PATH="$tmp/prefix" > "$tmp/configure.log" 2>&1 \
+# The example is compiled and linked with the flags the library was built with: a library built with sanitizers
+# (scripts/sanitize.sh) needs their runtime in the program that links it.
+cache() { sed -n "s/^$1:[A-Z]*=//p" "$build/CMakeCache.txt"; }
+cmake -S "$src/examples" -B "$tmp/examples" -DCMAKE_PREFIX_PATH="$tmp/prefix" \
+      -DCMAKE_CXX_FLAGS="$(cache CMAKE_CXX_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(cache CMAKE_EXE_LINKER_FLAGS)" \
+      > "$tmp/configure.log" 2>&1 \
   || { cat "$tmp/configure.log"; fail "find_package(fibernet) from the installed prefix"; }
 cmake --build "$tmp/examples" > "$tmp/build.log" 2>&1 || { cat "$tmp/build.log"; fail "building examples/"; }
 

@@ -26,7 +26,7 @@ DiscretizationParams coarse() {
 }
 }  // namespace
 
-TEST_CASE("pebble game and elastic Hessian agree on 200 open networks", "[rigidity][elastic]") {
+TEST_CASE("pebble game and elastic Hessian agree on 200 open networks", "[rigidity][elastic][slow]") {
     int agree = 0, n = 0, shear_rigid = 0, shear_free = 0;
     double max_zero = 0, min_nonzero = 1e300, max_G_free = 0, min_G_rigid = 1e300;
     for (std::uint64_t seed = 1; seed <= 200; ++seed) {
@@ -62,7 +62,7 @@ TEST_CASE("pebble game and elastic Hessian agree on 200 open networks", "[rigidi
     CHECK(shear_free > 20);
 }
 
-TEST_CASE("pebble game and elastic Hessian agree on the 200 networks of bench/compare_elastic.sh", "[rigidity][elastic]") {
+TEST_CASE("pebble game and elastic Hessian agree on the 200 networks of bench/compare_elastic.sh", "[rigidity][elastic][slow]") {
     // This population held the one disagreement of the unscaled bending-scale cut (q = 7, pl = 0.9, seed 26:
     // a segment of 1.7e-4 ls, lambda_max = 4e9); see elastic_rigidity.hpp.
     const double specs[5][3] = {{4, 0.6, 3.16}, {5, 0.7, 2.83}, {6, 0.8, 2.58}, {7, 0.9, 2.39}, {8, 1.0, 2.24}};
@@ -78,7 +78,7 @@ TEST_CASE("pebble game and elastic Hessian agree on the 200 networks of bench/co
     CHECK(agree == 200);
 }
 
-TEST_CASE("the comparison does not depend on the discretization", "[rigidity][elastic]") {
+TEST_CASE("the comparison does not depend on the discretization", "[rigidity][elastic][slow]") {
     // Finer even-scheme chains and the seed scheme have the same zero modes (every fiber stays rigid).
     for (std::uint64_t seed = 1; seed <= 6; ++seed) {
         const Network net = sample(seed);

@@ -167,7 +167,7 @@ TEST_CASE("cholmod_ldl: the pre-permuted factorization equals CHOLMOD's own bit 
 }
 
 TEST_CASE("cholmod_ldl: the two-thread order factors as CHOLMOD would in that order, on any thread count",
-          "[cholmod_ldl]") {
+          "[cholmod_ldl][slow]") {
     // A grid with indefinite spots and longer couplings, large enough for a separator; split_min 100 forces the
     // two-thread order (bisection, CAMD within [A][B][S]) that large Hessians get. Reference: CHOLMOD factoring
     // S = P (A + shift I) P^T in one call, in its natural order, with the same P; the modified solve written out.

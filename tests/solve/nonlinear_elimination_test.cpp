@@ -118,7 +118,7 @@ struct PlainReference {
 }  // namespace
 
 TEST_CASE("Newton with elimination returns plain Newton's equilibrium of the whole network, energy never rising",
-          "[solve][elimination]") {
+          "[solve][elimination][slow]") {
     PlainReference ref;
     REQUIRE(ref.plain.converged());
     StrainedEnergy& f = ref.f;
@@ -213,7 +213,7 @@ TEST_CASE("the Schwarz sweep's blocks cover every coordinate, connected, grown b
 }
 
 TEST_CASE("Newton with the Schwarz sweep returns plain Newton's equilibrium of the whole network, energy never rising",
-          "[solve][elimination]") {
+          "[solve][elimination][slow]") {
     PlainReference ref;
     REQUIRE(ref.plain.converged());
     for (int kind : {0, 1}) {
@@ -291,7 +291,7 @@ TEST_CASE("elimination's local solves share the caller's time budget", "[solve][
 }
 
 TEST_CASE("Newton's observe_within sees the state after each local solve of a sweep, its energy never rising",
-          "[solve][elimination]") {
+          "[solve][elimination][slow]") {
     PlainReference ref;
     Eigen::VectorXd q = ref.q0;
     SolverOptions o;

@@ -66,7 +66,7 @@ TEST_CASE("every suite solver finds the minimum of the extended Rosenbrock funct
 }
 
 TEST_CASE("on small sheared networks every solver reaches Newton's energy or reports that it did not",
-          "[solve][suite][network]") {
+          "[solve][suite][network][slow]") {
     const double tol = 1e-8;
     for (Scheme scheme : {Scheme::Even, Scheme::Seed}) {
         ShearedNetwork net(3, 8, scheme, 10, 0.05);
@@ -119,7 +119,7 @@ TEST_CASE("a tiny budget gives IterationLimit, not Converged", "[solve][suite][b
     }
 }
 
-TEST_CASE("a gradient that does not match the energy is never reported as converged", "[solve][suite][wrong]") {
+TEST_CASE("a gradient that does not match the energy is never reported as converged", "[solve][suite][wrong][slow]") {
     ShearedNetwork net(3, 8, Scheme::Even, 10, 0.05);
     WrongGradient f(*net.objective, 1e-3);
     const double floor = 1e-3 / (net.model.num_nodes());  // max|g| can never fall below this
@@ -136,7 +136,7 @@ TEST_CASE("a gradient that does not match the energy is never reported as conver
     }
 }
 
-TEST_CASE("a gradient with a force along a zero mode: solvers fail visibly", "[solve][suite][wrong]") {
+TEST_CASE("a gradient with a force along a zero mode: solvers fail visibly", "[solve][suite][wrong][slow]") {
     Rosenbrock rb(3, 1);
     WrongGradient f(rb, 1e-3, rb.size() - 1);
     for (const auto& name : solver_names()) {
