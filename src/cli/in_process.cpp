@@ -1,4 +1,5 @@
 #include "in_process.hpp"
+#include "unknown_flags.hpp"
 
 #include <algorithm>
 
@@ -49,6 +50,7 @@ CommandOutcome run_command(CLI::App& app, const std::vector<std::string>& argv, 
     command_argv() = argv;
     std::vector<std::string> reversed(argv.rbegin(), argv.rend());  // CLI11 takes a reversed vector
     try {
+        check_command_line(app, argv);
         app.parse(reversed);
         out.exit_code = exit_code();
     } catch (const CLI::CallForHelp&) {  // --help: the command's help as the result

@@ -6,6 +6,7 @@
 
 #include "common.hpp"
 #include "in_process.hpp"
+#include "unknown_flags.hpp"
 #include "fibernet_version.hpp"
 #include "fibernet/util/allocator.hpp"
 #include "fibernet/util/error.hpp"
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
             }
             if (!known) throw InputError(std::string("unknown command '") + argv[1] + "' (expected one of: " + names + ")");
         }
+        cli::check_command_line(app, std::vector<std::string>(argv + 1, argv + argc));
         app.parse(argc, argv);
         cli::flush_stdout();  // results on stdout count only once they are out (a full device fails here)
     } catch (const CLI::CallForHelp& e) {

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <string>
+#include <vector>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -79,6 +80,36 @@ TEST_CASE("cli: bad input exits 2, names the value and writes no output file", "
     CHECK(run("generate " + scene + " -o " + out) == 2);
     CHECK(slurp(tmpdir() + "/stderr").find("bad.toml: pl (crosslink probability) = -0.1") != std::string::npos);
     CHECK(!exists(out));
+}
+
+TEST_CASE("cli: an unknown flag is named as unknown, with the nearest flag, before its value is read as a scene",
+          "[cli][input]") {
+    const std::string out = tmpdir() + "/should_not_exist.txt";
+    struct Case {
+        std::string args;
+        std::vector<std::string> messages;
+    };
+    const Case cases[] = {
+        // Before, CLI11 took "8" for the scene file: "scene: File does not exist: 8".
+        {"modulus --L 4 --density 8", {"unknown flag '--density' for 'fibernet modulus'", "did you mean --q?"}},
+        {"modulus --L 4 --seeds 3", {"unknown flag '--seeds'", "did you mean --seed?"}},
+        {"modulus --L 4 --gamma-max 0.2", {"unknown flag '--gamma-max' for 'fibernet modulus'", "is a flag of:", "sweep"}},
+        {"modulus --L 4 --density=8", {"unknown flag '--density'"}},
+        // A flag that takes no value, then a word: the word was the scene file.
+        {"modulus --L 4 --open 8", {"'8' is not a scene file (no such file); --open takes no value"}},
+        // A value that starts with '-' is a value, not a flag.
+        {"relax --L 3 --q 5 --strain isotropic --gamma -3 --frob", {"unknown flag '--frob'"}},
+    };
+    for (const auto& c : cases) {
+        INFO(c.args);
+        CHECK(run(c.args + " -o " + out) == 2);
+        const std::string err = slurp(tmpdir() + "/stderr");
+        for (const std::string& m : c.messages) CHECK(err.find(m) != std::string::npos);
+        CHECK(err.find("File does not exist") == std::string::npos);
+        CHECK(!exists(out));
+    }
+    // Known flags with values that look like flags or come in lists still parse.
+    CHECK(run("modulus --L 3 --q 5 --gamma -0.01 -q") == 0);
 }
 
 TEST_CASE("cli: a result that cannot be written exits 4 naming where it went", "[cli][output]") {
