@@ -137,6 +137,12 @@ def test_bad_input_is_a_value_error_naming_it(kwargs, named):
     assert named in str(e.value)
 
 
+def test_run_names_an_unknown_flag_and_the_nearest():
+    # Before, the unknown flag's value was taken for the scene file ("scene: File does not exist: 8").
+    with pytest.raises(ValueError, match=r"unknown flag '--density' for 'fibernet modulus' \(did you mean --q\?\)"):
+        fn.run("modulus", "--L", "4", "--density", "8")
+
+
 def test_bad_input_writes_nothing(tmp_path):
     out = tmp_path / "sweep.csv"
     with pytest.raises(ValueError, match="q"):
