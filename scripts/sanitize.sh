@@ -15,18 +15,8 @@ if [ "${1:-}" = "--ci" ]; then
   ci=1
   shift
 fi
-bash scripts/setup.sh --no-build
-if [ "$ci" = 0 ]; then
-  # The whole suite runs LAMMPS, VTK and pytest too (scripts/setup.sh --all installs them).
-  for p in lammps python3-vtk9 python3-pytest; do
-    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="${missing:-} $p"
-  done
-  if [ -n "${missing:-}" ]; then
-    SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-    $SUDO apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing >&2
-  fi
-fi
+# The whole suite runs LAMMPS, VTK and pytest too: setup.sh --all installs them.
+if [ "$ci" = 1 ]; then bash scripts/setup.sh --no-build; else bash scripts/setup.sh --all --no-build; fi
 # -g1: line tables for the reports' stack traces, at a fraction of full debug information's compile time.
 flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo \
